@@ -1,0 +1,71 @@
+// The program shell every step uses: common flags, camera flags, one-line errors and
+// exit codes, and the choice between a window and the headless path.
+#pragma once
+
+#include <CLI/CLI.hpp>
+
+#include <functional>
+#include <optional>
+#include <string>
+#include <vector>
+
+#include "core/camera.hpp"
+#include "core/scene.hpp"
+#include "core/window.hpp"
+
+namespace boxes {
+
+struct CommonOptions {
+    bool headless = false;
+    std::string out;  // PNG written by the headless path
+    int width = 640;
+    int height = 480;
+    std::string scene;
+    uint64_t seed = 1;
+    bool json = false;        // print the measurements as JSON on stdout
+    std::string reportPath;   // also write them as JSON to this file
+    int threads = 0;          // 0: every hardware thread
+    std::string dataDir;
+    std::string eye, look, up;  // "X,Y,Z"
+    float fov = 0.0f;           // degrees; 0: the scene's
+    // Scripted window runs (tests, CI, screenshots).
+    int frames = 0;
+    std::string keys;  // comma-separated SDL key names, one per frame
+    std::string screenshot;
+
+    float aspect() const { return float(width) / float(height); }
+    WindowOptions windowOptions(const std::string& title) const;
+};
+
+// Adds --headless --out --width --height --scene --seed --json --report --threads --data
+// --eye --look --up --fov --frames --keys --screenshot.
+void addCommonOptions(CLI::App& app, CommonOptions& options, const std::string& defaultScene);
+
+// Parses; a help request prints help and exits 0; a bad flag throws UsageError.
+void parseCommandLine(CLI::App& app, int argc, char** argv);
+
+struct UsageError : std::runtime_error {
+    using std::runtime_error::runtime_error;
+};
+struct ExitRequest {
+    int code = 0;
+};
+
+// "X,Y,Z" -> vector; throws InputError naming the flag.
+Vec3 parseVec3(const std::string& text, const std::string& flag);
+
+// The scene's camera with --eye/--look/--up/--fov applied (and the image's aspect).
+Camera cameraFromOptions(const CommonOptions& options, const Camera& sceneCamera);
+
+// The scene named by --scene, in the image's aspect ratio, data from --data.
+Scene sceneFromOptions(const CommonOptions& options);
+
+// Runs body and turns every error into one line on stderr and an exit code:
+// 0 success, 1 bad input or failure, 2 bad command line, 3 an exercise not implemented.
+int runMain(const std::string& program, const std::function<int()>& body);
+
+// True when a window can probably be opened (DISPLAY, WAYLAND_DISPLAY, or an explicit
+// SDL_VIDEODRIVER).
+bool displayAvailable();
+
+}  // namespace boxes

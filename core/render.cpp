@@ -1,0 +1,280 @@
+#include "core/render.hpp"
+
+#include <cstdio>
+#include <mutex>
+#include <random>
+#include <thread>
+#include <unistd.h>
+
+#include "core/timing.hpp"
+
+namespace boxes {
+
+RayCounts& RayCounts::operator+=(const RayCounts& o) {
+    primary += o.primary;
+    shadow += o.shadow;
+    reflection += o.reflection;
+    refraction += o.refraction;
+    shadowSkipped += o.shadowSkipped;
+    lightsOutOfRange += o.lightsOutOfRange;
+    return *this;
+}
+
+namespace {
+
+bool boxTouchesBall(Vec3 lo, Vec3 hi, Vec3 centre, float radius) {
+    if (!std::isfinite(radius)) return true;
+    Vec3 nearest = glm::clamp(centre, lo, hi);
+    Vec3 d = nearest - centre;
+    return glm::dot(d, d) <= radius * radius;
+}
+
+}  // namespace
+
+SceneAnalysis analyzeScene(const Scene& scene) {
+    SceneAnalysis a;
+    auto noteMaterial = [&](int m) {
+        const Material& mat = scene.materials[size_t(m)];
+        if (mat.kind == Material::Kind::Mirror && mat.reflectance > 0.0f) a.reflection = true;
+        if (mat.kind == Material::Kind::Glass) a.reflection = a.refraction = true;
+    };
+    for (const auto& s : scene.spheres) {
+        noteMaterial(s.material);
+        a.convex.push_back(true);
+        a.isPlane.push_back(false);
+    }
+    for (const auto& p : scene.planes) {
+        noteMaterial(p.material);
+        a.convex.push_back(true);
+        a.isPlane.push_back(true);
+    }
+    for (const auto& g : scene.geometries) {
+        for (int m : g->materialsUsed()) noteMaterial(m);
+        a.convex.push_back(g->convex());
+        a.isPlane.push_back(false);
+    }
+    // An object outside a light's ball of influence cannot block that light for any lit
+    // point: the segment from a lit point to the light lies inside the (convex) ball.
+    for (const PointLight& light : scene.lights) {
+        std::vector<int> list;
+        int object = 0;
+        for (const auto& s : scene.spheres) {
+            Vec3 r(s.shape.radius);
+            if (boxTouchesBall(s.shape.centre - r, s.shape.centre + r, light.position,
+                               light.radius))
+                list.push_back(object);
+            ++object;
+        }
+        for (size_t i = 0; i < scene.planes.size(); ++i) list.push_back(object++);
+        for (const auto& g : scene.geometries) {
+            if (boxTouchesBall(g->boundsMin(), g->boundsMax(), light.position, light.radius))
+                list.push_back(object);
+            ++object;
+        }
+        a.occluders.push_back(std::move(list));
+    }
+    return a;
+}
+
+Vec3 offsetOrigin(const Vec3& point, const Vec3& geometricNormal, const Vec3& direction) {
+    // The offset grows with the coordinates' magnitude: float spacing does too.
+    float scale = 1e-4f * (1.0f + maxComponent(glm::abs(point)));
+    Vec3 n = glm::dot(geometricNormal, direction) >= 0.0f ? geometricNormal : -geometricNormal;
+    return point + scale * n;
+}
+
+Renderer::Renderer(const Scene& scene, const Camera& camera, const RenderSettings& settings)
+    : scene_(scene), camera_(camera), settings_(settings) {
+    if (settings.width <= 0 || settings.height <= 0)
+        throw std::invalid_argument("image size must be positive");
+    if (settings.samplesPerPixel < 1) throw std::invalid_argument("samples per pixel must be >= 1");
+    scene.checkRenderable();
+    basis_ = camera_.basis();
+    analysis_ = analyzeScene(scene);
+}
+
+bool Renderer::needsShadowRay(int light, const SurfaceHit& hit) const {
+    const Vec3 lightPos = scene_.lights[size_t(light)].position;
+    for (int object : analysis_.occluders[size_t(light)]) {
+        if (object == hit.object) {
+            if (!analysis_.convex[size_t(object)]) return true;
+            continue;
+        }
+        if (analysis_.isPlane[size_t(object)]) {
+            // A plane blocks only points on the other side from the light.
+            const Plane& p = scene_.planes[size_t(object) - scene_.spheres.size()].shape;
+            float sp = glm::dot(p.normal, hit.point) + p.d;
+            float sl = glm::dot(p.normal, lightPos) + p.d;
+            if ((sp > 0.0f && sl > 0.0f) || (sp < 0.0f && sl < 0.0f)) continue;
+        }
+        return true;
+    }
+    return false;
+}
+
+Vec3 Renderer::shade(const Ray& ray, const SurfaceHit& hit, int depth, RayCounts& counts) const {
+    const Material& m = scene_.materials[size_t(hit.material)];
+    const bool force = settings_.forceAllEffects;
+    // Shade the side the ray arrives from.
+    bool entering = glm::dot(ray.direction, hit.geometricNormal) < 0.0f;
+    Vec3 ng = entering ? hit.geometricNormal : -hit.geometricNormal;
+    Vec3 n = glm::dot(hit.shadingNormal, ng) >= 0.0f ? hit.shadingNormal : -hit.shadingNormal;
+
+    Vec3 colour(0.0f);
+    if (m.kind == Material::Kind::Diffuse) {
+        colour = scene_.ambient * m.albedo;
+        for (size_t i = 0; i < scene_.lights.size(); ++i) {
+            const PointLight& light = scene_.lights[i];
+            Vec3 toLight = light.position - hit.point;
+            float dist2 = glm::dot(toLight, toLight);
+            float cosine = glm::dot(n, toLight);
+            bool inRange = dist2 <= light.radius * light.radius;
+            bool facing = cosine > 0.0f && glm::dot(ng, toLight) > 0.0f;
+            if (!inRange) ++counts.lightsOutOfRange;
+            bool contributes = inRange && facing;
+            if (!contributes && !force) continue;
+            bool shadowNeeded = needsShadowRay(int(i), hit);
+            bool visible = true;
+            if (shadowNeeded || force) {
+                ++counts.shadow;
+                Ray shadowRay(offsetOrigin(hit.point, hit.geometricNormal, toLight), toLight, 0.0f,
+                              1.0f - 1e-5f);
+                visible = !scene_.occluded(shadowRay);
+            } else {
+                ++counts.shadowSkipped;
+            }
+            if (contributes && visible)
+                colour += m.albedo * light.intensity * (cosine / (dist2 * std::sqrt(dist2)));
+        }
+    }
+    if (depth >= settings_.maxDepth) return colour;
+
+    // Mirror reflection, and for glass reflection and refraction weighted by Fresnel.
+    float reflectWeight = 0.0f, refractWeight = 0.0f;
+    Vec3 tint(1.0f);
+    Vec3 refracted(0.0f);
+    bool canRefract = false;
+    Vec3 d = glm::normalize(ray.direction);
+    if (m.kind == Material::Kind::Mirror) {
+        reflectWeight = m.reflectance;
+        tint = m.albedo;
+    } else if (m.kind == Material::Kind::Glass) {
+        float nFrom = entering ? 1.0f : m.ior, nTo = entering ? m.ior : 1.0f;
+        float cosI = -glm::dot(d, ng);
+        canRefract = refract(d, ng, nFrom / nTo, refracted);
+        reflectWeight = canRefract ? fresnelDielectric(cosI, nFrom, nTo) : 1.0f;
+        refractWeight = 1.0f - reflectWeight;
+    }
+    if (reflectWeight > 0.0f || force) {
+        ++counts.reflection;
+        Vec3 r = reflect(d, ng);
+        Vec3 c = trace(Ray(offsetOrigin(hit.point, hit.geometricNormal, r), r), depth + 1, counts);
+        colour += reflectWeight * tint * c;
+    }
+    if (refractWeight > 0.0f || force) {
+        ++counts.refraction;
+        Vec3 t = canRefract ? refracted : d;
+        Vec3 c = trace(Ray(offsetOrigin(hit.point, hit.geometricNormal, t), t), depth + 1, counts);
+        colour += refractWeight * c;
+    }
+    return colour;
+}
+
+Vec3 Renderer::trace(const Ray& ray, int depth, RayCounts& counts) const {
+    SurfaceHit hit;
+    if (!scene_.intersect(ray, hit)) return scene_.background;
+    return shade(ray, hit, depth, counts);
+}
+
+Vec3 Renderer::pixel(int x, int y, RayCounts& counts) const {
+    const int w = settings_.width, h = settings_.height;
+    const int spp = settings_.samplesPerPixel;
+    if (spp == 1) {
+        ++counts.primary;
+        Ray ray(camera_.eye, camera_.directionThrough(basis_, float(x) + 0.5f, float(y) + 0.5f, w, h));
+        return trace(ray, 0, counts);
+    }
+    // Stratified samples: an n x n grid (n = ceil(sqrt(spp))), jittered, the first spp taken.
+    int n = int(std::ceil(std::sqrt(double(spp))));
+    std::mt19937_64 rng(settings_.seed * 0x9E3779B97F4A7C15ull + uint64_t(y) * uint64_t(w) + uint64_t(x));
+    std::uniform_real_distribution<float> uniform(0.0f, 1.0f);
+    Vec3 sum(0.0f);
+    for (int s = 0; s < spp; ++s) {
+        float sx = (float(s % n) + uniform(rng)) / float(n);
+        float sy = (float(s / n) + uniform(rng)) / float(n);
+        ++counts.primary;
+        Ray ray(camera_.eye, camera_.directionThrough(basis_, float(x) + sx, float(y) + sy, w, h));
+        sum += trace(ray, 0, counts);
+    }
+    return sum / float(spp);
+}
+
+void Renderer::renderRows(Image& image, int rowBegin, int rowEnd, RayCounts& counts) const {
+    for (int y = rowBegin; y < rowEnd; ++y)
+        for (int x = 0; x < settings_.width; ++x) image.at(x, y) = pixel(x, y, counts);
+}
+
+Image Renderer::render(RayCounts* counts) const {
+    Image image(settings_.width, settings_.height);
+    int threads = settings_.threads > 0 ? settings_.threads
+                                        : int(std::max(1u, std::thread::hardware_concurrency()));
+    std::vector<RayCounts> perThread(static_cast<size_t>(threads));
+    parallelRows(
+        settings_.height, threads,
+        [&](int row, int thread) { renderRows(image, row, row + 1, perThread[size_t(thread)]); },
+        settings_.progressLabel);
+    if (counts)
+        for (const RayCounts& c : perThread) *counts += c;
+    return image;
+}
+
+Image renderImage(const Scene& scene, const Camera& camera, const RenderSettings& settings,
+                  RayCounts* counts) {
+    return Renderer(scene, camera, settings).render(counts);
+}
+
+void parallelRows(int rows, int threads, const std::function<void(int, int)>& body,
+                  const std::string& label) {
+    if (threads <= 0) threads = int(std::max(1u, std::thread::hardware_concurrency()));
+    threads = std::max(1, std::min(threads, rows));
+    std::atomic<int> next{0};
+    std::atomic<int> done{0};
+    std::mutex printMutex;
+    Stopwatch watch;
+    std::atomic<double> lastPrint{0.0};
+    const bool tty = isatty(fileno(stderr));
+    auto report = [&](bool final) {
+        if (label.empty() || watch.seconds() < 1.0) return;
+        std::lock_guard<std::mutex> lock(printMutex);
+        double now = watch.seconds();
+        if (!final && now - lastPrint.load() < (tty ? 0.2 : 5.0)) return;
+        lastPrint = now;
+        int percent = int(100.0 * done.load() / rows);
+        std::fprintf(stderr, tty ? "\r%s: %3d%% (%.1f s)%s" : "%s: %3d%% (%.1f s)%s\n",
+                     label.c_str(), percent, now, final && tty ? "\n" : "");
+        std::fflush(stderr);
+    };
+    std::exception_ptr error;
+    std::mutex errorMutex;
+    auto worker = [&](int thread) {
+        try {
+            for (int row; (row = next.fetch_add(1)) < rows;) {
+                body(row, thread);
+                ++done;
+                report(false);
+            }
+        } catch (...) {
+            std::lock_guard<std::mutex> lock(errorMutex);
+            if (!error) error = std::current_exception();
+            next = rows;  // stop the others
+        }
+    };
+    std::vector<std::thread> pool;
+    for (int t = 1; t < threads; ++t) pool.emplace_back(worker, t);
+    worker(0);
+    for (auto& t : pool) t.join();
+    if (error) std::rethrow_exception(error);
+    report(true);
+}
+
+}  // namespace boxes

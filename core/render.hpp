@@ -1,0 +1,86 @@
+// A Whitted-style ray tracer: direct light with shadow rays, mirror reflection, glass
+// with Fresnel and total internal reflection, up to a maximum depth. It simulates only
+// the effects the scene calls for (WORKBOOK.md, promise 3) and counts every ray it traces.
+#pragma once
+
+#include <atomic>
+#include <cstdint>
+#include <functional>
+#include <string>
+#include <vector>
+
+#include "core/image.hpp"
+#include "core/scene.hpp"
+
+namespace boxes {
+
+struct RayCounts {
+    uint64_t primary = 0, shadow = 0, reflection = 0, refraction = 0;
+    uint64_t shadowSkipped = 0;      // shadow rays the scene analysis proved unnecessary
+    uint64_t lightsOutOfRange = 0;   // light evaluations beyond the light's radius
+    uint64_t total() const { return primary + shadow + reflection + refraction; }
+    RayCounts& operator+=(const RayCounts& o);
+};
+
+struct RenderSettings {
+    int width = 640;
+    int height = 480;
+    int maxDepth = 5;         // primary rays are depth 0
+    int threads = 0;          // 0: every hardware thread
+    int samplesPerPixel = 1;  // > 1: stratified jitter within the pixel
+    uint64_t seed = 1;
+    bool forceAllEffects = false;  // trace every effect, as if the analysis were off
+    std::string progressLabel;     // when set, long renders print progress to stderr
+};
+
+// What can contribute, derived once from the scene.
+struct SceneAnalysis {
+    bool reflection = false;  // some material reflects (mirror or glass)
+    bool refraction = false;  // some material is glass
+    // occluders[light]: objects that may block that light somewhere (their bounds reach
+    // the light's sphere of influence); planes are checked per point by side.
+    std::vector<std::vector<int>> occluders;
+    std::vector<bool> convex;  // per object: cannot shadow itself
+    std::vector<bool> isPlane;
+};
+SceneAnalysis analyzeScene(const Scene& scene);
+
+class Renderer {
+public:
+    Renderer(const Scene& scene, const Camera& camera, const RenderSettings& settings);
+
+    Image render(RayCounts* counts = nullptr) const;
+    // Renders rows [rowBegin, rowEnd) of `image` (single thread), adding to counts.
+    void renderRows(Image& image, int rowBegin, int rowEnd, RayCounts& counts) const;
+    Vec3 pixel(int x, int y, RayCounts& counts) const;
+    // Radiance along a ray; depth 0 is a primary ray.
+    Vec3 trace(const Ray& ray, int depth, RayCounts& counts) const;
+
+    const SceneAnalysis& analysis() const { return analysis_; }
+    const RenderSettings& settings() const { return settings_; }
+
+private:
+    Vec3 shade(const Ray& ray, const SurfaceHit& hit, int depth, RayCounts& counts) const;
+    bool needsShadowRay(int light, const SurfaceHit& hit) const;
+
+    const Scene& scene_;
+    Camera camera_;
+    CameraBasisT<float> basis_;
+    RenderSettings settings_;
+    SceneAnalysis analysis_;
+};
+
+// Renders the whole image with the scene's geometry (rows in parallel).
+Image renderImage(const Scene& scene, const Camera& camera, const RenderSettings& settings,
+                  RayCounts* counts = nullptr);
+
+// Runs body(row) for every row on `threads` threads (0: all), rows handed out one at a
+// time; prints progress for long runs when label is not empty.
+void parallelRows(int rows, int threads, const std::function<void(int row, int thread)>& body,
+                  const std::string& label = "");
+
+// Shadow and secondary rays start slightly off the surface, on the side they leave
+// towards, so they do not hit the surface they start on (self-intersection acne).
+Vec3 offsetOrigin(const Vec3& point, const Vec3& geometricNormal, const Vec3& direction);
+
+}  // namespace boxes

@@ -1,0 +1,184 @@
+// The mini-core: images, meshes, timing, tables, scenes and the renderer's promise 3.
+#include <cmath>
+
+#include "core/image.hpp"
+#include "core/mesh.hpp"
+#include "core/render.hpp"
+#include "core/report.hpp"
+#include "core/scene.hpp"
+#include "core/timing.hpp"
+#include "support.hpp"
+
+using namespace boxes;
+
+TEST_SUITE("core") {
+    TEST_CASE("image: PNG round trip keeps size and 8-bit values") {
+        test::TempDir dir;
+        Image img(5, 3);
+        for (int y = 0; y < 3; ++y)
+            for (int x = 0; x < 5; ++x) img.at(x, y) = Vec3(x / 4.0f, y / 2.0f, 0.5f);
+        img.writePng(dir.file("a.png"));
+        CHECK(test::pngSize(dir.file("a.png")) == std::pair{5, 3});
+        Image back = Image::readPng(dir.file("a.png"));
+        REQUIRE(back.width() == 5);
+        // The round trip is exact after one quantization to 8 bits.
+        CHECK(back.toRgb8() == img.toRgb8());
+        CHECK(back.at(0, 0).r == 0.0f);
+        CHECK(back.at(4, 2).g == 1.0f);
+    }
+    TEST_CASE("image: sRGB encoding of 8-bit values round-trips exactly") {
+        for (int v = 0; v < 256; ++v) CHECK(encodeSrgb8(decodeSrgb8(uint8_t(v))) == v);
+        CHECK(encodeSrgb8(std::nanf("")) == 0);
+        CHECK(encodeSrgb8(2.0f) == 255);
+    }
+    TEST_CASE("image: a failed write leaves no file behind") {
+        test::TempDir dir;
+        CHECK_THROWS_AS(Image(2, 2).writePng(dir.file("no/such/dir/a.png")), std::runtime_error);
+        CHECK(std::filesystem::is_empty(dir.path));
+    }
+    TEST_CASE("image: zero size is refused") {
+        CHECK_THROWS_AS(Image(0, 10), std::invalid_argument);
+        CHECK_THROWS_AS(Image(10, -1), std::invalid_argument);
+    }
+    TEST_CASE("image: RMSE and max error of a known difference") {
+        Image a(2, 1, Vec3(0.5f)), b(2, 1, Vec3(0.5f));
+        b.at(1, 0) = Vec3(0.5f, 0.5f, 0.9f);  // one channel of six differs by 0.4
+        ImageDifference d = compareImages(a, b);
+        CHECK(d.maxError == doctest::Approx(0.4).epsilon(1e-6));
+        CHECK(d.rmse == doctest::Approx(std::sqrt(0.16 / 6.0)).epsilon(1e-6));
+        CHECK(d.pixelsDiffering == 1);
+        CHECK_THROWS(compareImages(a, Image(1, 1)));
+    }
+    TEST_CASE("mesh: OBJ polygons are fan-triangulated in file order") {
+        Mesh m = parseObj("v 0 0 0\nv 1 0 0\nv 1 1 0\nv 0 1 0\nv 0 0 1\nf 1 2 3 4\nf 1/1/1 2/2/2 5/3/3\nf -1 -2 -3\n");
+        REQUIRE(m.triangleCount() == 4);
+        CHECK(m.triangles[0] == std::array<uint32_t, 3>{0, 1, 2});
+        CHECK(m.triangles[1] == std::array<uint32_t, 3>{0, 2, 3});
+        CHECK(m.triangles[2] == std::array<uint32_t, 3>{0, 1, 4});
+        CHECK(m.triangles[3] == std::array<uint32_t, 3>{4, 3, 2});  // negative: relative to the end
+        CHECK(m.normals.size() == 5);
+        CHECK(glm::length(m.normals[2]) == doctest::Approx(1.0f));
+    }
+    TEST_CASE("mesh: malformed files are refused with one line naming the problem") {
+        auto message = [](const std::string& text) {
+            try {
+                parseObj(text, "x.obj");
+            } catch (const InputError& e) {
+                return std::string(e.what());
+            }
+            return std::string("(accepted)");
+        };
+        CHECK(message("").find("empty") != std::string::npos);
+        CHECK(message("v 0 0 0\nv 1 0 0\n").find("no triangles") != std::string::npos);
+        CHECK(message("v 0 0 0\nv 1 zero 0\nv 0 1 0\nf 1 2 3\n").find("not a number") != std::string::npos);
+        CHECK(message("v 0 0 0\nv 1 0 0\nv 0 1 0\nf 1 2 4\n").find("range") != std::string::npos);
+        CHECK(message("v 0 0 0\nv 1 0\nv 0 1 0\nf 1 2 3\n").find("3 coordinates") != std::string::npos);
+        CHECK(message("v 0 0 0\nv 1e39 0 0\nv 0 1 0\nf 1 2 3\n").find("range") != std::string::npos);
+        CHECK(message("v 0 0 0\nv nan 0 0\nv 0 1 0\nf 1 2 3\n").find("non-finite") != std::string::npos);
+        for (const std::string& m : {message(""), message("v 0 0 0\nv 1 0 0\nv 0 1 0\nf 1 2 9\n")})
+            CHECK(m.find('\n') == std::string::npos);
+        CHECK_THROWS_AS(loadObj("/nonexistent/file.obj"), InputError);
+    }
+    TEST_CASE("timing: median and min and max of samples") {
+        Timing t = summarize({3.0, 1.0, 2.0, 10.0, 4.0});
+        CHECK(t.median == 3.0);
+        CHECK(t.min == 1.0);
+        CHECK(t.max == 10.0);
+        Timing even = summarize({4.0, 1.0, 2.0, 3.0}, 2);
+        CHECK(even.median == 1.25);  // (2 + 3) / 2 per repeat, 2 calls each
+    }
+    TEST_CASE("report: a table prints aligned text and JSON rows") {
+        Table t;
+        t.id = "x";
+        t.title = "T";
+        t.columns = {"name", "value"};
+        t.row({std::string("a"), 1.5}).row({std::string("bb"), (long long)42});
+        nlohmann::json j = t.toJson();
+        CHECK(j["rows"].size() == 2);
+        CHECK(j["rows"][0][1] == 1.5);
+        CHECK(j["rows"][1][1] == 42);
+        std::ostringstream out;
+        t.print(out);
+        CHECK(out.str().find("bb") != std::string::npos);
+    }
+    TEST_CASE("scene: the nearest of spheres and planes") {
+        Scene s;
+        s.spheres.push_back({{Vec3(0, 0, -5), 1.0f}, 0});
+        s.spheres.push_back({{Vec3(0, 0, -3), 0.5f}, 0});
+        s.planes.push_back({{Vec3(0, 0, 1), 10.0f}, 0});  // z = -10
+        SurfaceHit hit;
+        REQUIRE(s.intersect(Ray(Vec3(0), Vec3(0, 0, -1)), hit));
+        CHECK(hit.t == doctest::Approx(2.5f));
+        CHECK(hit.object == 1);
+        REQUIRE(s.intersect(Ray(Vec3(3, 0, 0), Vec3(0, 0, -1)), hit));
+        CHECK(hit.t == doctest::Approx(10.0f));
+        CHECK(hit.kind == SurfaceHit::Kind::Plane);
+        CHECK(s.occluded(Ray(Vec3(0), Vec3(0, 0, -1), 0.0f, 2.6f)));
+        CHECK_FALSE(s.occluded(Ray(Vec3(0), Vec3(0, 0, -1), 0.0f, 2.4f)));
+    }
+    TEST_CASE("light radius: where intensity / d^2 falls to half an 8-bit step") {
+        // I = 2: d = sqrt(2 / (0.5/255)) = sqrt(1020).
+        CHECK(PointLight::radiusFor(Vec3(2.0f, 1.0f, 0.5f)) == doctest::Approx(std::sqrt(1020.0f)));
+    }
+}
+
+TEST_SUITE("renderer") {
+    TEST_CASE("effects on demand: every scene kind renders the identical image with fewer rays") {
+        for (const char* name : {"spheres", "diffuse", "mirrors", "glass", "single-sphere", "small-lights"}) {
+            INFO(name);
+            Scene scene = makeScene(name, SceneOptions{test::dataDir(), 4.0f / 3.0f});
+            RenderSettings s;
+            s.width = 40;
+            s.height = 30;
+            s.maxDepth = 4;
+            RayCounts lean, forced;
+            Image a = renderImage(scene, scene.camera, s, &lean);
+            s.forceAllEffects = true;
+            Image b = renderImage(scene, scene.camera, s, &forced);
+            CHECK(a.pixels() == b.pixels());
+            CHECK(lean.total() < forced.total());
+            CHECK(lean.primary == forced.primary);
+        }
+    }
+    TEST_CASE("effects on demand: what each scene needs") {
+        auto counts = [](const char* name) {
+            Scene scene = makeScene(name, SceneOptions{test::dataDir(), 4.0f / 3.0f});
+            RenderSettings s;
+            s.width = 40;
+            s.height = 30;
+            RayCounts c;
+            renderImage(scene, scene.camera, s, &c);
+            return c;
+        };
+        RayCounts single = counts("single-sphere");
+        CHECK(single.shadow == 0);  // one convex object: nothing can cast a shadow
+        CHECK(single.reflection == 0);
+        CHECK(single.shadowSkipped > 0);
+        RayCounts diffuse = counts("diffuse");
+        CHECK(diffuse.reflection == 0);
+        CHECK(diffuse.refraction == 0);
+        CHECK(diffuse.shadow > 0);
+        RayCounts mirrors = counts("mirrors");
+        CHECK(mirrors.reflection > 0);
+        CHECK(mirrors.refraction == 0);
+        RayCounts glass = counts("glass");
+        CHECK(glass.refraction > 0);
+        RayCounts small = counts("small-lights");
+        CHECK(small.lightsOutOfRange > 0);
+    }
+    TEST_CASE("renderer: a glass sphere's refraction and a mirror's reflection show up") {
+        Scene scene = makeScene("spheres", SceneOptions{test::dataDir(), 1.0f});
+        RenderSettings s;
+        s.width = s.height = 32;
+        Image with = renderImage(scene, scene.camera, s);
+        s.maxDepth = 0;
+        Image without = renderImage(scene, scene.camera, s);
+        CHECK(compareImages(with, without).pixelsDiffering > 20);
+    }
+    TEST_CASE("renderer: a scene with a mesh but no geometry for it is refused") {
+        Scene scene;
+        scene.mesh = parseObj("v 0 0 0\nv 1 0 0\nv 0 1 0\nf 1 2 3\n");
+        RenderSettings s;
+        CHECK_THROWS_AS(renderImage(scene, scene.camera, s), std::logic_error);
+    }
+}

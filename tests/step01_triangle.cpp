@@ -1,0 +1,340 @@
+// Step 01: the exercises with hand-worked numbers, the hard cases by name, and the program.
+#include <cmath>
+#include <random>
+
+#include "01_triangle/measure.hpp"
+#include "01_triangle/triangle.hpp"
+#include "01_triangle/triangle_grid.hpp"
+#include "core/render.hpp"
+#include "core/scene.hpp"
+#include "support.hpp"
+
+using namespace boxes;
+using boxes::test::checkVec;
+
+namespace {
+
+// The unit right triangle in the z = 0 plane and its neighbour across the hypotenuse.
+const Triangled kUnit{{0, 0, 0}, {1, 0, 0}, {0, 1, 0}};
+const Triangled kUnitNeighbour{{1, 0, 0}, {1, 1, 0}, {0, 1, 0}};
+// The triangle that cuts the three axes at 1.
+const Triangled kDiagonal{{1, 0, 0}, {0, 1, 0}, {0, 0, 1}};
+
+template <typename T>
+TriangleT<T> cast(const Triangled& t) {
+    return {Vec3T<T>(t.a), Vec3T<T>(t.b), Vec3T<T>(t.c)};
+}
+
+}  // namespace
+
+TEST_SUITE("exercise 1.1") {
+    TEST_CASE("triangle plane: normal from the cross product and d") {
+        auto p = trianglePlane(kUnit);
+        REQUIRE(p.has_value());
+        checkVec(p->normal, Vec3d(0, 0, 1), 1e-15);
+        CHECK(p->d == 0.0);
+        // x + y + z = 1: N = (1,1,1)/sqrt(3), d = -1/sqrt(3).
+        auto q = trianglePlane(kDiagonal);
+        REQUIRE(q.has_value());
+        double s = 1.0 / std::sqrt(3.0);
+        checkVec(q->normal, Vec3d(s, s, s), 1e-15);
+        CHECK(q->d == doctest::Approx(-s));
+        // The winding decides the side: reversed winding, reversed normal.
+        auto r = trianglePlane(Triangled{kUnit.a, kUnit.c, kUnit.b});
+        REQUIRE(r.has_value());
+        checkVec(r->normal, Vec3d(0, 0, -1), 1e-15);
+    }
+    TEST_CASE("triangle plane: in float the same numbers") {
+        auto q = trianglePlane(cast<float>(kDiagonal));
+        REQUIRE(q.has_value());
+        float s = 1.0f / std::sqrt(3.0f);
+        checkVec(q->normal, Vec3(s), 1e-6);
+        CHECK(q->d == doctest::Approx(-s).epsilon(1e-6));
+    }
+    TEST_CASE("hard case: a degenerate triangle has no plane") {
+        CHECK_FALSE(trianglePlane(Triangled{{0, 0, 0}, {1, 1, 1}, {2, 2, 2}}).has_value());
+        CHECK_FALSE(trianglePlane(Triangled{{1, 2, 3}, {1, 2, 3}, {4, 5, 6}}).has_value());
+        CHECK_FALSE(trianglePlane(Triangle{{1, 2, 3}, {1, 2, 3}, {1, 2, 3}}).has_value());
+    }
+}
+
+TEST_SUITE("exercise 1.2") {
+    TEST_CASE("ray/plane distance: worked examples") {
+        // z = 0 seen from (0,0,5) looking down: t = 5.
+        auto t = rayPlaneDistance(Rayd({0, 0, 5}, {0, 0, -1}), PlaneT<double>{{0, 0, 1}, 0});
+        REQUIRE(t.has_value());
+        CHECK(*t == 5.0);
+        // The exam's plane x + z = 10 from E = (1,1,1) along V = (1,0,1): t = 4, P = (5,1,5).
+        Rayd ray({1, 1, 1}, {1, 0, 1});
+        auto t2 = rayPlaneDistance(ray, PlaneT<double>{{1, 0, 1}, -10});
+        REQUIRE(t2.has_value());
+        CHECK(*t2 == doctest::Approx(4.0));
+        checkVec(ray.at(*t2), Vec3d(5, 1, 5), 1e-12);
+    }
+    TEST_CASE("hard case: ray/plane parallel or in the plane and the sign of t") {
+        PlaneT<double> z0{{0, 0, 1}, 0};
+        CHECK_FALSE(rayPlaneDistance(Rayd({0, 0, 1}, {1, 0, 0}), z0).has_value());  // parallel
+        CHECK_FALSE(rayPlaneDistance(Rayd({0, 0, 0}, {1, 1, 0}), z0).has_value());  // in plane
+        // -x - z = 10 lies behind the eye: t = -6, negative, and still reported.
+        auto behind = rayPlaneDistance(Rayd({1, 1, 1}, {1, 0, 1}), PlaneT<double>{{-1, 0, -1}, -10});
+        REQUIRE(behind.has_value());
+        CHECK(*behind == doctest::Approx(-6.0));
+        // Float, -0.0 in the direction: still parallel.
+        CHECK_FALSE(rayPlaneDistance(Ray({0, 0, 1}, {1, 0, -0.0f}), PlaneT<float>{{0, 0, 1}, 0}).has_value());
+    }
+}
+
+TEST_SUITE("exercise 1.3") {
+    TEST_CASE("inside test: barycentrics of a worked point") {
+        // (0.25, 0.25, 1) straight down: the three edge volumes are -0.5, -0.25, -0.25.
+        auto uv = insideEdgePlanes(Rayd({0.25, 0.25, 1}, {0, 0, -1}), kUnit);
+        REQUIRE(uv.has_value());
+        CHECK(uv->x == doctest::Approx(0.25));
+        CHECK(uv->y == doctest::Approx(0.25));
+        // Seen from below the signs flip together: still inside.
+        auto below = insideEdgePlanes(Rayd({0.25, 0.25, -1}, {0, 0, 1}), kUnit);
+        REQUIRE(below.has_value());
+        CHECK(below->x == doctest::Approx(0.25));
+        CHECK_FALSE(insideEdgePlanes(Rayd({1, 1, 1}, {0, 0, -1}), kUnit).has_value());
+        CHECK_FALSE(insideEdgePlanes(Rayd({-0.1, 0.5, 1}, {0, 0, -1}), kUnit).has_value());
+    }
+    TEST_CASE("plane test put together: t and u and v") {
+        auto h = intersectPlaneTest(Rayd({0.2, 0.3, 2}, {0, 0, -1}), kUnit);
+        REQUIRE(h.has_value());
+        CHECK(h->t == doctest::Approx(2.0));
+        CHECK(h->u == doctest::Approx(0.2));
+        CHECK(h->v == doctest::Approx(0.3));
+    }
+}
+
+// The three full tests must agree on these worked numbers.
+template <typename Real>
+void checkWorkedHits(TriangleTest test) {
+    INFO(triangleTestName(test) << (sizeof(Real) == 4 ? " in float" : " in double"));
+    RayT<Real> down({Real(0.2), Real(0.3), Real(2)}, {0, 0, -1});
+    auto h = intersectTriangle(test, down, cast<Real>(kUnit));
+    REQUIRE(h.has_value());
+    CHECK(double(h->t) == doctest::Approx(2.0).epsilon(1e-6));
+    CHECK(double(h->u) == doctest::Approx(0.2).epsilon(1e-6));
+    CHECK(double(h->v) == doctest::Approx(0.3).epsilon(1e-6));
+    // From the origin along (1,1,1): the centroid (1/3,1/3,1/3), t = 1/3, u = v = 1/3.
+    RayT<Real> diag({0, 0, 0}, {1, 1, 1});
+    auto g = intersectTriangle(test, diag, cast<Real>(kDiagonal));
+    REQUIRE(g.has_value());
+    CHECK(double(g->t) == doctest::Approx(1.0 / 3.0).epsilon(1e-6));
+    CHECK(double(g->u) == doctest::Approx(1.0 / 3.0).epsilon(1e-6));
+    CHECK(double(g->v) == doctest::Approx(1.0 / 3.0).epsilon(1e-6));
+    // Outside, behind, and beyond tmax: misses.
+    const auto tri = cast<Real>(kUnit);
+    CHECK_FALSE(intersectTriangle(test, RayT<Real>({1, 1, 2}, {0, 0, -1}), tri));
+    CHECK_FALSE(intersectTriangle(test, RayT<Real>({Real(0.2), Real(0.2), -1}, {0, 0, -1}), tri));
+    CHECK_FALSE(intersectTriangle(test, RayT<Real>({Real(0.2), Real(0.2), 2}, {0, 0, -1}, 0, Real(1.5)), tri));
+    // Closed interval: a hit exactly at tmax counts.
+    CHECK(intersectTriangle(test, RayT<Real>({Real(0.25), Real(0.25), 2}, {0, 0, -1}, 0, Real(2)), tri));
+}
+
+// Hard cases every full test must pass; `exact` tests must also close every crack.
+void checkHardCases(TriangleTest test) {
+    INFO(triangleTestName(test));
+    SUBCASE("hard case: a degenerate triangle misses without NaN") {
+        for (const Triangled& t : {Triangled{{0, 0, 0}, {1, 0, 0}, {2, 0, 0}},
+                                   Triangled{{0, 0, 0}, {0, 0, 0}, {0, 1, 0}},
+                                   Triangled{{1, 1, 0}, {1, 1, 0}, {1, 1, 0}}}) {
+            CHECK_FALSE(intersectTriangle(test, Rayd({0.5, 0, 1}, {0, 0, -1}), t));
+            CHECK_FALSE(intersectTriangle(test, Rayd({1, 1, 1}, {0, 0, -1}), t));
+            CHECK_FALSE(intersectTriangle(test, Ray({1, 1, 1}, {0, 0, -1}), cast<float>(t)));
+        }
+    }
+    SUBCASE("hard case: a ray parallel to the plane, and one inside it, miss") {
+        CHECK_FALSE(intersectTriangle(test, Rayd({0.2, 0.2, 1}, {1, 0, 0}), kUnit));
+        CHECK_FALSE(intersectTriangle(test, Rayd({-1, 0.25, 0}, {1, 0, 0}), kUnit));
+        CHECK_FALSE(intersectTriangle(test, Ray({-1, 0.25f, 0}, {1, 0, -0.0f}), cast<float>(kUnit)));
+    }
+    SUBCASE("hard case: the scene scaled by 2^k, k in [-20, 20], keeps its hits") {
+        std::mt19937_64 rng(7);
+        std::uniform_real_distribution<double> u01(0.0, 1.0);
+        for (int i = 0; i < 50; ++i) {
+            Vec3d o(u01(rng) - 0.5, u01(rng) - 0.5, 2.0 + u01(rng));
+            Vec3d target(0.6 * u01(rng), 0.6 * u01(rng), 0.0);
+            Ray base(Vec3(o), Vec3(target - o));
+            auto h0 = intersectTriangle(test, base, cast<float>(kDiagonal));
+            for (int k = -20; k <= 20; ++k) {
+                float s = std::ldexp(1.0f, k);
+                Triangle t{cast<float>(kDiagonal).a * s, cast<float>(kDiagonal).b * s, cast<float>(kDiagonal).c * s};
+                auto h = intersectTriangle(test, Ray(base.origin * s, base.direction), t);
+                INFO("k = " << k);
+                REQUIRE(h.has_value() == h0.has_value());
+                if (h) CHECK(std::abs(double(h->t) / (double(h0->t) * s) - 1.0) < 1e-6);
+            }
+        }
+    }
+}
+
+template <TriangleTest X>
+using TestKind = std::integral_constant<TriangleTest, X>;
+
+TEST_SUITE("exercise 1.3") {
+    TEST_CASE("plane test: the worked hits in float and double") {
+        checkWorkedHits<float>(TriangleTest::PlaneTest);
+        checkWorkedHits<double>(TriangleTest::PlaneTest);
+    }
+    TEST_CASE("plane test: hard cases") { checkHardCases(TriangleTest::PlaneTest); }
+}
+
+TEST_SUITE("exercise 1.4") {
+    TEST_CASE("Moller-Trumbore: the worked hits in float and double") {
+        checkWorkedHits<float>(TriangleTest::MollerTrumbore);
+        checkWorkedHits<double>(TriangleTest::MollerTrumbore);
+    }
+    TEST_CASE("Moller-Trumbore: hard cases") { checkHardCases(TriangleTest::MollerTrumbore); }
+}
+
+TEST_SUITE("exercise 1.5") {
+    TEST_CASE("watertight: the worked hits in float and double") {
+        checkWorkedHits<float>(TriangleTest::Watertight);
+        checkWorkedHits<double>(TriangleTest::Watertight);
+    }
+    TEST_CASE("watertight: hard cases") { checkHardCases(TriangleTest::Watertight); }
+
+    TEST_CASE("hard case: a ray through a shared edge hits at least one of the two triangles") {
+        // Rays at float points along the shared hypotenuse, from many directions.
+        std::mt19937_64 rng(11);
+        std::uniform_real_distribution<float> u01(0.0f, 1.0f);
+        const Triangle a = cast<float>(kUnit), b = cast<float>(kUnitNeighbour);
+        for (int i = 0; i < 20000; ++i) {
+            float s = u01(rng);
+            Vec3 target(1.0f - s, s, 0.0f);
+            Vec3 origin(u01(rng) * 4 - 2, u01(rng) * 4 - 2, 0.5f + u01(rng) * 3);
+            Ray ray(origin, target - origin);
+            INFO("ray " << i);
+            REQUIRE((intersectWatertight(ray, a) || intersectWatertight(ray, b)));
+        }
+    }
+    TEST_CASE("hard case: a ray through a shared vertex hits at least one triangle of the fan") {
+        // Six triangles around the vertex (0.1, 0.7, 0.3) of a hexagonal fan.
+        const Vec3 centre(0.1f, 0.7f, 0.3f);
+        std::vector<Triangle> fan;
+        auto rim = [&](int k) {
+            float a = kPi / 3 * float(k % 6);
+            return centre + Vec3(std::cos(a), std::sin(a), k % 2 ? 0.1f : -0.1f);
+        };
+        for (int k = 0; k < 6; ++k) fan.push_back({centre, rim(k), rim(k + 1)});
+        std::mt19937_64 rng(5);
+        std::uniform_real_distribution<float> u01(0.0f, 1.0f);
+        for (int i = 0; i < 20000; ++i) {
+            Vec3 origin = centre + Vec3(u01(rng) * 2 - 1, u01(rng) * 2 - 1, 1.0f + u01(rng));
+            Ray ray(origin, centre - origin);
+            bool hit = false;
+            for (const Triangle& t : fan) hit = hit || intersectWatertight(ray, t).has_value();
+            INFO("ray " << i);
+            REQUIRE(hit);
+        }
+    }
+    TEST_CASE("hard case: far geometry has no cracks (closed mesh moved to 1000 -700 300)") {
+        Mesh sh1 = loadObj(test::dataDir() + "/meshes/sh1.obj");
+        const Vec3 far(1000.0f, -700.0f, 300.0f);
+        CrackRaySet set = makeCrackRays(sh1, 20000, 20000, 3, far);
+        CHECK(set.edgeRays.size() > 10000);
+        CHECK(set.vertexRays.size() > 10000);
+        CHECK(countCracks<float>(sh1, set.edgeRays, TriangleTest::Watertight, far) == 0);
+        CHECK(countCracks<float>(sh1, set.vertexRays, TriangleTest::Watertight, far) == 0);
+        CHECK(countCracks<double>(sh1, set.edgeRays, TriangleTest::Watertight, far) == 0);
+        CrackRaySet near = makeCrackRays(sh1, 20000, 20000, 4);
+        CHECK(countCracks<float>(sh1, near.edgeRays, TriangleTest::Watertight) == 0);
+        CHECK(countCracks<float>(sh1, near.vertexRays, TriangleTest::Watertight) == 0);
+    }
+}
+
+TEST_SUITE("exercise 1.6") {
+    TEST_CASE("normal interpolation: worked values") {
+        Vec3 x(1, 0, 0), y(0, 1, 0), z(0, 0, 1);
+        float s3 = 1.0f / std::sqrt(3.0f), s2 = 1.0f / std::sqrt(2.0f);
+        checkVec(interpolateNormal(x, y, z, 1.0f / 3, 1.0f / 3), Vec3(s3), 1e-6);
+        checkVec(interpolateNormal(x, y, z, 0.5f, 0.0f), Vec3(s2, s2, 0), 1e-6);
+        checkVec(interpolateNormal(x, y, z, 0.0f, 1.0f), z, 1e-7);
+        checkVec(interpolateNormal(x, y, z, 0.0f, 0.0f), x, 1e-7);
+        CHECK(glm::length(interpolateNormal(x, y, z, 0.2f, 0.7f)) == doctest::Approx(1.0f));
+    }
+}
+
+TEST_SUITE("renderer") {
+    TEST_CASE("effects on demand: a mesh scene renders the same image with fewer rays") {
+        Scene scene = makeScene("sh1", SceneOptions{test::dataDir(), 4.0f / 3.0f});
+        scene.geometries.push_back(std::make_shared<TriangleGrid>(scene.mesh, scene.meshMaterial));
+        RenderSettings s;
+        s.width = 48;
+        s.height = 36;
+        RayCounts lean, forced;
+        Image a = renderImage(scene, scene.camera, s, &lean);
+        s.forceAllEffects = true;
+        Image b = renderImage(scene, scene.camera, s, &forced);
+        CHECK(a.pixels() == b.pixels());
+        CHECK(lean.total() < forced.total());
+        CHECK(lean.reflection == 0);
+        CHECK(forced.reflection > 0);
+        CHECK(lean.shadow > 0);  // a mesh can shadow itself
+    }
+}
+
+TEST_SUITE("program 01") {
+    const std::string program = BOXES_PROGRAM;
+
+    TEST_CASE("headless render writes a PNG of the requested size") {
+        test::TempDir dir;
+        auto run = test::runProgram(program, "--headless --scene sh1 --width 64 --height 40 --out a.png", dir);
+        INFO(run.err);
+        REQUIRE(run.exitCode == 0);
+        CHECK(test::pngSize(dir.file("a.png")) == std::pair{64, 40});
+    }
+    TEST_CASE("measurements: the JSON report has the speed and crack tables") {
+        test::TempDir dir;
+        auto run = test::runProgram(
+            program, "--headless --scene sh1 --width 32 --height 24 --out a.png --measure --crack-rays 2000 --report r.json",
+            dir);
+        INFO(run.err);
+        REQUIRE(run.exitCode == 0);
+        std::string json = test::readText(dir.file("r.json"));
+        CHECK(json.find("\"triangle_speed\"") != std::string::npos);
+        CHECK(json.find("\"cracks\"") != std::string::npos);
+        CHECK(test::pngSize(dir.file("a-disagree.png")) == std::pair{32, 24});
+        CHECK(run.out.find("watertight float") != std::string::npos);
+    }
+    TEST_CASE("window: scripted frames with key presses under the offscreen video driver") {
+        test::TempDir dir;
+        auto run = test::runProgram(program,
+                                    "--scene sh1 --width 64 --height 48 --frames 4 --keys t,m,t,Left "
+                                    "--screenshot shot.png",
+                                    dir, "SDL_VIDEODRIVER=offscreen");
+        INFO(run.err);
+        REQUIRE(run.exitCode == 0);
+        CHECK(test::pngSize(dir.file("shot.png")).first > 0);
+    }
+    TEST_CASE("bad input: one clear line and a non-zero exit") {
+        test::TempDir dir;
+        std::ofstream(dir.file("letters.obj")) << "v 0 0 0\nv 1 x 0\nv 0 1 0\nf 1 2 3\n";
+        std::ofstream(dir.file("range.obj")) << "v 0 0 0\nv 1 0 0\nv 0 1 0\nf 1 2 7\n";
+        std::ofstream(dir.file("empty.obj")) << "";
+        struct Case {
+            std::string args, expect;
+            int code;
+        };
+        for (const Case& c : std::vector<Case>{
+                 {"--scene missing.obj", "no such file", 1},
+                 {"--scene letters.obj", "not a number", 1},
+                 {"--scene range.obj", "out of range", 1},
+                 {"--scene empty.obj", "empty", 1},
+                 {"--scene nosuchscene", "unknown scene", 1},
+                 {"--frobnicate", "frobnicate", 2},
+                 {"--width 0", "width", 2},
+                 {"--eye 1,2,3 --look 1,2,3", "view direction is zero", 1},
+                 {"--up 0,0,0", "up vector is zero", 1},
+                 {"--eye 1,2", "expected X,Y,Z", 1}}) {
+            INFO(c.args);
+            auto run = test::runProgram(program, "--headless --out bad.png " + c.args, dir);
+            CHECK(run.exitCode == c.code);
+            CHECK(test::lineCount(run.err) == 1);
+            CHECK(run.err.find(c.expect) != std::string::npos);
+            CHECK_FALSE(std::filesystem::exists(dir.file("bad.png")));
+        }
+    }
+}

@@ -1,0 +1,86 @@
+// Helpers shared by the test files: running a step program, reading PNG sizes, checking
+// numbers against hand-worked values.
+#pragma once
+
+#include <doctest/doctest.h>
+
+#include <cstdlib>
+#include <filesystem>
+#include <fstream>
+#include <sstream>
+#include <string>
+
+#include "core/math.hpp"
+
+namespace boxes::test {
+
+inline std::string dataDir() { return BOXES_TEST_DATA; }
+
+// A fresh folder under the system's temporary directory, removed at scope exit.
+struct TempDir {
+    std::filesystem::path path;
+    TempDir() {
+        std::string pattern = (std::filesystem::temp_directory_path() / "boxes-test-XXXXXX").string();
+        path = mkdtemp(pattern.data());
+    }
+    ~TempDir() {
+        std::error_code ec;
+        std::filesystem::remove_all(path, ec);
+    }
+    std::string file(const std::string& name) const { return (path / name).string(); }
+};
+
+inline std::string readText(const std::string& path) {
+    std::ifstream in(path, std::ios::binary);
+    std::stringstream s;
+    s << in.rdbuf();
+    return s.str();
+}
+
+struct ProgramRun {
+    int exitCode = -1;
+    std::string out, err;
+};
+
+// Runs `program args` in `dir` with extra environment assignments ("A=1 B=2").
+inline ProgramRun runProgram(const std::string& program, const std::string& args,
+                             const TempDir& dir, const std::string& env = "") {
+    std::string out = dir.file("stdout.txt"), err = dir.file("stderr.txt");
+    std::string cmd = "cd '" + dir.path.string() + "' && env " + env + " '" + program + "' " +
+                      args + " >'" + out + "' 2>'" + err + "' </dev/null";
+    int status = std::system(cmd.c_str());
+    ProgramRun run;
+    run.exitCode = WIFEXITED(status) ? WEXITSTATUS(status) : 128 + WTERMSIG(status);
+    run.out = readText(out);
+    run.err = readText(err);
+    return run;
+}
+
+inline size_t lineCount(const std::string& s) {
+    size_t n = 0;
+    for (char c : s) n += c == '\n';
+    return n + (!s.empty() && s.back() != '\n');
+}
+
+// Width and height from a PNG file's IHDR chunk; (0, 0) when it is not a PNG.
+inline std::pair<int, int> pngSize(const std::string& path) {
+    std::string bytes = readText(path);
+    if (bytes.size() < 24 || bytes.compare(1, 3, "PNG") != 0) return {0, 0};
+    auto be32 = [&](size_t i) {
+        return int((uint8_t(bytes[i]) << 24) | (uint8_t(bytes[i + 1]) << 16) |
+                   (uint8_t(bytes[i + 2]) << 8) | uint8_t(bytes[i + 3]));
+    };
+    return {be32(16), be32(20)};
+}
+
+// Every component within an absolute tolerance.
+template <typename A, typename B>
+void checkVec(const A& actual, const B& expected, double tolerance) {
+    for (int i = 0; i < 3; ++i) {
+        INFO("component " << i << ": got " << double(actual[i]) << ", expected "
+                          << double(expected[i]));
+        CHECK(std::abs(double(actual[i]) - double(expected[i])) <= tolerance);
+    }
+}
+
+}  // namespace boxes::test

@@ -1,0 +1,56 @@
+#!/usr/bin/env bash
+# Installs the Debian packages a workbook command needs, when they are missing.
+# usage: tools/deps.sh GROUP...   (groups: build test report slides fuzz grade bench)
+# As root it runs apt-get; otherwise it prints the exact apt-get line and exits 1.
+set -euo pipefail
+
+pkgs_for() {
+  case "$1" in
+  build)
+    echo g++ cmake ninja-build pkg-config libglm-dev libsdl2-dev doctest-dev libstb-dev \
+      libtinyobjloader-dev libcli11-dev libimgui-dev nlohmann-json3-dev libgl-dev \
+      libegl1 libgl1-mesa-dri
+    ;;
+  test) echo python3 ;;
+  report) echo python3 python3-matplotlib ;;
+  slides) echo chromium ;;
+  fuzz) echo clang libclang-rt-dev ;;
+  grade) echo bubblewrap python3 ;;
+  bench) echo libbenchmark-dev libembree-dev python3-numpy ;;
+  *)
+    echo "tools/deps.sh: unknown group '$1'" >&2
+    exit 2
+    ;;
+  esac
+}
+
+wanted=()
+for group in "$@"; do
+  for p in $(pkgs_for "$group"); do wanted+=("$p"); done
+done
+
+missing=()
+for p in "${wanted[@]}"; do
+  status=$(dpkg-query -W -f='${Status}' "$p" 2>/dev/null || true)
+  [[ "$status" == "install ok installed" ]] || missing+=("$p")
+done
+# de-duplicate while keeping order
+mapfile -t missing < <(printf '%s\n' "${missing[@]}" | awk 'NF && !seen[$0]++')
+[[ ${#missing[@]} -eq 0 ]] && exit 0
+
+line="apt-get install -y --no-install-recommends ${missing[*]}"
+if [[ $(id -u) -ne 0 ]]; then
+  echo "Missing Debian packages. Run as root:" >&2
+  echo "  apt-get update && $line" >&2
+  exit 1
+fi
+echo "[deps] installing: ${missing[*]}" >&2
+export DEBIAN_FRONTEND=noninteractive
+if ! apt-get install -y --no-install-recommends "${missing[@]}" >/tmp/boxes-apt.log 2>&1; then
+  apt-get update >>/tmp/boxes-apt.log 2>&1
+  apt-get install -y --no-install-recommends "${missing[@]}" >>/tmp/boxes-apt.log 2>&1 || {
+    echo "[deps] apt-get failed; see /tmp/boxes-apt.log" >&2
+    tail -5 /tmp/boxes-apt.log >&2
+    exit 1
+  }
+fi

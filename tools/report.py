@@ -1,0 +1,182 @@
+#!/usr/bin/python3
+"""Writes out/index.html from the steps' JSON reports (out/NN_name.json), their images, and
+the tests' XML results (out/test_*.xml, doctest's XML reporter): every step's images,
+its measurement tables and plots (matplotlib), and the status of every exercise.
+
+usage: tools/report.py OUT_DIR
+"""
+import glob
+import html
+import json
+import os
+import re
+import sys
+import xml.etree.ElementTree as ET
+
+import matplotlib
+
+matplotlib.use("Agg")
+import matplotlib.pyplot as plt  # noqa: E402
+
+ROOT = os.path.dirname(os.path.dirname(os.path.abspath(__file__)))
+EXERCISE = re.compile(r"//\s*EXERCISE\s+(\d+\.\d+):\s*(.*?)\s*\((\d+)\s+points?\)")
+
+
+def exercises():
+    """(id, title, points, file) for every exercise marker in the steps' sources."""
+    found = []
+    for path in sorted(glob.glob(os.path.join(ROOT, "steps", "*", "*.[ch]pp"))):
+        with open(path, encoding="utf-8") as f:
+            for line in f:
+                m = EXERCISE.search(line)
+                if m:
+                    found.append((m.group(1), m.group(2), int(m.group(3)), os.path.relpath(path, ROOT)))
+    return sorted(found, key=lambda e: tuple(int(x) for x in e[0].split(".")))
+
+
+def suite_results(out):
+    """{suite name: (passed, failed)} from doctest XML files."""
+    results = {}
+    for path in glob.glob(os.path.join(out, "test_*.xml")):
+        try:
+            tree = ET.parse(path)
+        except ET.ParseError:
+            continue
+        for suite in tree.getroot().iter("TestSuite"):
+            name = suite.get("name", "")
+            passed, failed = results.get(name, (0, 0))
+            for case in suite.iter("TestCase"):
+                res = case.find("OverallResultsAsserts")
+                ok = res is not None and res.get("failures", "0") == "0" and res.get("test_case_success", "true") == "true"
+                if case.find("Exception") is not None:
+                    ok = False
+                passed, failed = (passed + 1, failed) if ok else (passed, failed + 1)
+            results[name] = (passed, failed)
+    return results
+
+
+def table_html(t):
+    rows = "".join(
+        "<tr>" + "".join(f"<td>{html.escape(fmt(c))}</td>" for c in r) + "</tr>" for r in t["rows"]
+    )
+    head = "".join(f"<th>{html.escape(c)}</th>" for c in t["columns"])
+    note = f"<p class=note>{html.escape(t['note'])}</p>" if t.get("note") else ""
+    return f"<h3>{html.escape(t['title'])}</h3><table><tr>{head}</tr>{rows}</table>{note}"
+
+
+def fmt(c):
+    if isinstance(c, float):
+        if c == 0:
+            return "0"
+        a = abs(c)
+        if a >= 1e6 or a < 1e-3:
+            return f"{c:.3g}"
+        return f"{c:.1f}" if a >= 100 else f"{c:.4g}"
+    return str(c)
+
+
+def plot(report, spec, out, name):
+    table = next((t for t in report["tables"] if t["id"] == spec["table"]), None)
+    if table is None:
+        return None
+    cols = table["columns"]
+    try:
+        xi, yi = cols.index(spec["x"]), cols.index(spec["y"])
+    except ValueError:
+        return None
+    si = cols.index(spec["series"]) if spec.get("series") in cols else None
+    fig, ax = plt.subplots(figsize=(6.4, 4.0), dpi=100)
+    groups = {}
+    for r in table["rows"]:
+        x, y = r[xi], r[yi]
+        if not isinstance(x, (int, float)) or not isinstance(y, (int, float)):
+            continue
+        key = str(r[si]) if si is not None else ""
+        groups.setdefault(key, []).append((x, y))
+    for key, pts in groups.items():
+        pts.sort()
+        style = "o-" if spec.get("lines") else "o"
+        ax.plot([p[0] for p in pts], [p[1] for p in pts], style, label=key or None)
+        if not spec.get("lines") and len(pts) == 1:
+            ax.annotate(key, pts[0], textcoords="offset points", xytext=(5, 5), fontsize=8)
+    if spec.get("logx"):
+        ax.set_xscale("symlog" if any(p[0] <= 0 for g in groups.values() for p in g) else "log")
+    if spec.get("logy"):
+        ax.set_yscale("symlog" if any(p[1] <= 0 for g in groups.values() for p in g) else "log")
+    ax.set_xlabel(spec["x"])
+    ax.set_ylabel(spec["y"])
+    ax.set_title(spec.get("title", table["title"]), fontsize=10)
+    ax.grid(True, alpha=0.3)
+    if si is not None and len(groups) > 1:
+        ax.legend(fontsize=8)
+    fig.tight_layout()
+    path = os.path.join(out, name)
+    fig.savefig(path)
+    plt.close(fig)
+    return os.path.basename(path)
+
+
+def main():
+    out = sys.argv[1] if len(sys.argv) > 1 else "out"
+    reports = []
+    for path in sorted(glob.glob(os.path.join(out, "[0-9][0-9]_*.json"))):
+        with open(path, encoding="utf-8") as f:
+            reports.append(json.load(f))
+    results = suite_results(out)
+    parts = []
+    machine = reports[0]["machine"] if reports else "unknown machine"
+    # Exercise status.
+    rows = []
+    total = earned = 0
+    for ex, title, points, src in exercises():
+        passed, failed = results.get(f"exercise {ex}", (0, 0))
+        status = "passed" if passed and not failed else ("failed" if failed else "not run")
+        total += points
+        earned += points if status == "passed" else 0
+        rows.append(
+            f"<tr class={status.replace(' ', '')}><td>{ex}</td><td>{html.escape(title)}</td>"
+            f"<td>{points}</td><td>{passed}/{passed + failed}</td><td>{status}</td><td><code>{src}</code></td></tr>"
+        )
+    parts.append(
+        f"<h2 id=exercises>Exercises: {earned} of {total} points pass</h2>"
+        "<table><tr><th>exercise</th><th>what</th><th>points</th><th>test cases passed</th>"
+        "<th>status</th><th>source</th></tr>" + "".join(rows) + "</table>"
+    )
+    for r in reports:
+        prog = r["program"]
+        sec = [f"<h2 id='{prog}'>Step {html.escape(prog)}</h2>"]
+        for img in r.get("images", []):
+            rel = os.path.relpath(img["path"], out) if os.path.isabs(img["path"]) else os.path.relpath(img["path"], out)
+            if rel.startswith(".."):
+                rel = os.path.basename(img["path"])
+            sec.append(
+                f"<figure><img src='{html.escape(rel)}'><figcaption>{html.escape(img['caption'])}</figcaption></figure>"
+            )
+        for i, spec in enumerate(r.get("plots", [])):
+            name = plot(r, spec, out, f"{prog}-plot{i}.png")
+            if name:
+                sec.append(f"<figure><img src='{name}'><figcaption>{html.escape(spec.get('title', ''))}</figcaption></figure>")
+        for t in r.get("tables", []):
+            sec.append(table_html(t))
+        if r.get("facts"):
+            facts = "".join(f"<li><b>{html.escape(k)}</b>: {html.escape(fmt(v))}</li>" for k, v in r["facts"].items())
+            sec.append(f"<ul class=facts>{facts}</ul>")
+        parts.append("<section>" + "".join(sec) + "</section>")
+    slides = ""
+    if os.path.exists(os.path.join(out, "slides", "index.html")):
+        slides = "<p><a href='slides/index.html'>The slides</a></p>"
+    nav = " | ".join(f"<a href='#{r['program']}'>{r['program']}</a>" for r in reports)
+    page = f"""<!doctype html><html><head><meta charset=utf-8><title>Boxes workbook: the tour</title>
+<style>body{{font-family:sans-serif;max-width:1100px;margin:2em auto;color:#222}}
+table{{border-collapse:collapse;margin:.5em 0;font-size:90%}}td,th{{border:1px solid #ccc;padding:2px 8px;text-align:right}}
+td:first-child,th:first-child{{text-align:left}}tr.passed td{{background:#e8f6e8}}tr.failed td{{background:#fbe3e3}}
+figure{{display:inline-block;margin:.5em}}img{{max-width:640px;border:1px solid #ddd}}.note{{color:#666;font-size:85%}}</style></head>
+<body><h1>Boxes workbook: the tour</h1><p>Measured on {html.escape(machine)}. <a href='#exercises'>Exercises</a> | {nav}</p>{slides}
+{''.join(parts)}</body></html>"""
+    with open(os.path.join(out, "index.html"), "w", encoding="utf-8") as f:
+        f.write(page)
+    print(f"[workbook] wrote {os.path.join(out, 'index.html')}", file=sys.stderr)
+
+
+if __name__ == "__main__":
+    main()

@@ -304,7 +304,7 @@ TEST_SUITE("program 01") {
         auto run = test::runProgram(program,
                                     "--scene sh1 --width 64 --height 48 --frames 4 --keys t,m,t,Left "
                                     "--screenshot shot.png",
-                                    dir, "SDL_VIDEODRIVER=offscreen");
+                                    dir, test::kWindowEnvironment);
         INFO(run.err);
         REQUIRE(run.exitCode == 0);
         CHECK(test::pngSize(dir.file("shot.png")).first > 0);

@@ -129,34 +129,56 @@ BvhBuildStats bvhStats(const Bvh& bvh, const BvhBuildOptions& options);
 // ---------------------------------------------------------------------------------------
 // Traversal.
 
-// A ray prepared for box tests: reciprocal direction (+-infinity for a zero component).
+// A ray prepared for box tests: reciprocal direction (+-infinity for a zero component),
+// and the origin moved by a margin, so the box test is conservative with respect to the
+// watertight triangle test. That test translates the vertices to the ray origin and shears
+// them, rounding each time: it can report a hit up to a few float steps of |vertex - O|
+// outside the exact triangle (Woop, Benthin, Wald 2013, section 4: the box test must
+// allow for the same error). We widen each box by
+//   margin = 64 * 2^-24 * (|O - centre| + radius)   (the root's bounding sphere),
+// an upper bound of that error for every vertex in the tree, folded into two origins:
+// minimum planes use O + margin and maximum planes O - margin (same cost as one origin).
 struct TraversalRay {
-    Vec3 origin, direction, inverseDirection;
+    Vec3 originForMin, originForMax, direction, inverseDirection;
     float tmin, tmax;
-    explicit TraversalRay(const Ray& ray)
-        : origin(ray.origin),
+    explicit TraversalRay(const Ray& ray, float margin = 0.0f)
+        : originForMin(ray.origin + Vec3(margin)),
+          originForMax(ray.origin - Vec3(margin)),
           direction(ray.direction),
-          inverseDirection(1.0f / ray.direction.x, 1.0f / ray.direction.y, 1.0f / ray.direction.z),
+          inverseDirection(1.0f / ray.direction.x, 1.0f / ray.direction.y,
+                           1.0f / ray.direction.z),
           tmin(ray.tmin),
           tmax(ray.tmax) {}
+    // The margin for the triangles of `bvh` (see above).
+    TraversalRay(const Ray& ray, const Bvh& bvh) : TraversalRay(ray, marginFor(ray, bvh)) {}
+
+    static float marginFor(const Ray& ray, const Bvh& bvh) {
+        if (bvh.empty()) return 0.0f;
+        Bounds3f b = bvh.bounds();
+        float radius = 0.5f * glm::length(b.diagonal());
+        return 64.0f * 0x1p-24f * (glm::length(ray.origin - b.centroid()) + radius);
+    }
 };
 
 // 1 + 2 gamma(3), gamma(n) = n eps / (1 - n eps) with eps = 2^-24 (pbrt-v4, Ize 2013):
-// widening the slab test's far distance by it makes the float box test conservative, so a
-// box is never missed by a ray that hits a triangle inside it.
+// widening the slab test's far distance by it makes the float slab test itself
+// conservative (its own roundings never drop a box the exact ray touches).
 constexpr float kBoxFarScale = 1.0f + 2.0f * (3.0f * 0x1p-24f) / (1.0f - 3.0f * 0x1p-24f);
 
 // The conservative slab test against a node's box in [ray.tmin, tmax]; tEntry is where the
 // ray enters (>= ray.tmin). Not step 03's exercise: the hierarchy needs its own copy.
 // 0 * infinity (origin on a slab plane, zero direction component) gives NaN, and the
 // comparisons below ignore a NaN bound: the ray lies in that plane, and the closed box
-// contains it along that axis.
+// contains it along that axis. Components through pointers: glm's operator[] is a switch.
 inline bool intersectNodeBounds(const BvhNode& node, const TraversalRay& ray, float tmax,
                                 float& tEntry) {
+    const float *lo = &node.boundsMin.x, *hi = &node.boundsMax.x;
+    const float *oLo = &ray.originForMin.x, *oHi = &ray.originForMax.x;
+    const float* inv = &ray.inverseDirection.x;
     float t0 = ray.tmin, t1 = tmax;
     for (int axis = 0; axis < 3; ++axis) {
-        float tNear = (node.boundsMin[axis] - ray.origin[axis]) * ray.inverseDirection[axis];
-        float tFar = (node.boundsMax[axis] - ray.origin[axis]) * ray.inverseDirection[axis];
+        float tNear = (lo[axis] - oLo[axis]) * inv[axis];
+        float tFar = (hi[axis] - oHi[axis]) * inv[axis];
         if (tNear > tFar) std::swap(tNear, tFar);
         tFar *= kBoxFarScale;
         t0 = tNear > t0 ? tNear : t0;

@@ -16,8 +16,8 @@ namespace boxes {
 
 struct RayCounts {
     uint64_t primary = 0, shadow = 0, reflection = 0, refraction = 0;
-    uint64_t shadowSkipped = 0;      // shadow rays the scene analysis proved unnecessary
-    uint64_t lightsOutOfRange = 0;   // light evaluations beyond the light's radius
+    uint64_t shadowSkipped = 0;     // shadow rays the scene analysis proved unnecessary
+    uint64_t lightsOutOfRange = 0;  // light evaluations beyond the light's radius
     uint64_t total() const { return primary + shadow + reflection + refraction; }
     RayCounts& operator+=(const RayCounts& o);
 };
@@ -46,7 +46,7 @@ struct SceneAnalysis {
 SceneAnalysis analyzeScene(const Scene& scene);
 
 class Renderer {
-public:
+  public:
     Renderer(const Scene& scene, const Camera& camera, const RenderSettings& settings);
 
     Image render(RayCounts* counts = nullptr) const;
@@ -59,7 +59,7 @@ public:
     const SceneAnalysis& analysis() const { return analysis_; }
     const RenderSettings& settings() const { return settings_; }
 
-private:
+  private:
     Vec3 shade(const Ray& ray, const SurfaceHit& hit, int depth, RayCounts& counts) const;
     bool needsShadowRay(int light, const SurfaceHit& hit) const;
 
@@ -78,6 +78,26 @@ Image renderImage(const Scene& scene, const Camera& camera, const RenderSettings
 // time; prints progress for long runs when label is not empty.
 void parallelRows(int rows, int threads, const std::function<void(int row, int thread)>& body,
                   const std::string& label = "");
+
+// The normals of a hit as seen by a viewer looking along `direction`: the geometric normal
+// turned towards the viewer, the shading normal turned to the same side. Shared by the ray
+// tracer and step 06's rasterizer so both shade a point the same way.
+struct FacingNormals {
+    Vec3 geometric, shading;
+};
+FacingNormals facingNormals(const Vec3& direction, const SurfaceHit& hit);
+
+// What one point light gives a diffuse point before any shadow test:
+// albedo * intensity * cos / d^2 (cosine with the shading normal), and whether it can
+// contribute at all (in range, and in front of both normals).
+struct DirectLight {
+    Vec3 toLight{0.0f};  // unnormalized, from the point to the light
+    Vec3 radiance{0.0f};
+    bool inRange = false, facing = false;
+    bool contributes() const { return inRange && facing; }
+};
+DirectLight directLight(const Material& material, const PointLight& light, const Vec3& point,
+                        const FacingNormals& normals);
 
 // Shadow and secondary rays start slightly off the surface, on the side they leave
 // towards, so they do not hit the surface they start on (self-intersection acne).

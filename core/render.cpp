@@ -1,11 +1,10 @@
 #include "core/render.hpp"
 
-#include <unistd.h>
-
 #include <cstdio>
 #include <mutex>
 #include <random>
 #include <thread>
+#include <unistd.h>
 
 #include "core/timing.hpp"
 
@@ -206,14 +205,12 @@ Vec3 Renderer::pixel(int x, int y, RayCounts& counts) const {
     const int spp = settings_.samplesPerPixel;
     if (spp == 1) {
         ++counts.primary;
-        Ray ray(camera_.eye,
-                camera_.directionThrough(basis_, float(x) + 0.5f, float(y) + 0.5f, w, h));
+        Ray ray(camera_.eye, camera_.directionThrough(basis_, float(x) + 0.5f, float(y) + 0.5f, w, h));
         return trace(ray, 0, counts);
     }
     // Stratified samples: an n x n grid (n = ceil(sqrt(spp))), jittered, the first spp taken.
     int n = int(std::ceil(std::sqrt(double(spp))));
-    std::mt19937_64 rng(settings_.seed * 0x9E3779B97F4A7C15ull + uint64_t(y) * uint64_t(w) +
-                        uint64_t(x));
+    std::mt19937_64 rng(settings_.seed * 0x9E3779B97F4A7C15ull + uint64_t(y) * uint64_t(w) + uint64_t(x));
     std::uniform_real_distribution<float> uniform(0.0f, 1.0f);
     Vec3 sum(0.0f);
     for (int s = 0; s < spp; ++s) {

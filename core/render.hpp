@@ -16,8 +16,8 @@ namespace boxes {
 
 struct RayCounts {
     uint64_t primary = 0, shadow = 0, reflection = 0, refraction = 0;
-    uint64_t shadowSkipped = 0;     // shadow rays the scene analysis proved unnecessary
-    uint64_t lightsOutOfRange = 0;  // light evaluations beyond the light's radius
+    uint64_t shadowSkipped = 0;      // shadow rays the scene analysis proved unnecessary
+    uint64_t lightsOutOfRange = 0;   // light evaluations beyond the light's radius
     uint64_t total() const { return primary + shadow + reflection + refraction; }
     RayCounts& operator+=(const RayCounts& o);
 };
@@ -46,7 +46,7 @@ struct SceneAnalysis {
 SceneAnalysis analyzeScene(const Scene& scene);
 
 class Renderer {
-  public:
+public:
     Renderer(const Scene& scene, const Camera& camera, const RenderSettings& settings);
 
     Image render(RayCounts* counts = nullptr) const;
@@ -59,7 +59,7 @@ class Renderer {
     const SceneAnalysis& analysis() const { return analysis_; }
     const RenderSettings& settings() const { return settings_; }
 
-  private:
+private:
     Vec3 shade(const Ray& ray, const SurfaceHit& hit, int depth, RayCounts& counts) const;
     bool needsShadowRay(int light, const SurfaceHit& hit) const;
 

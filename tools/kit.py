@@ -49,10 +49,11 @@ def stub_lines(ex, indent):
     return lines
 
 
-def strip_solutions(text, path, root):
-    """The file's text with every solution block replaced; (new text, exercises)."""
+def strip_solutions(text, path, root, keep=()):
+    """The file's text with every solution block replaced (but those of the exercises in
+    `keep`, e.g. {"1.4"}); returns (new text, the exercises replaced)."""
     lines = text.split("\n")
-    found = parse_file(path, root)
+    found = [e for e in parse_file(path, root) if e.id not in keep]
     for ex in found:
         if ex.begin < 0 or ex.end < 0:
             raise SystemExit(f"kit: {ex.path}: exercise {ex.id} has no complete "

@@ -8,6 +8,7 @@ usage: tests/grading_test.py SCENARIO WORK_DIR
   one-solved     a kit with one exercise solved scores exactly that exercise's points
   compile-error  a step that does not compile scores zero with the compiler's error; the
                  other graded steps keep their points
+  hidden         an instructor's hidden tests count, and a hanging test case times out
 
 The steps are discovered, not named: grading scenarios use the first step with exercises
 (and the last one for the compile error), so they keep working as steps are added. All
@@ -137,6 +138,17 @@ def scenario_kit_zero(work):
     first = steps_with_exercises()[0]
     with tempfile.TemporaryDirectory() as student:
         student_tree(student, keep=())
+        # A student's own copies of the tests and of the points never count: tests that
+        # always pass and a marker worth 100 points change nothing.
+        os.makedirs(os.path.join(student, "tests"))
+        for e in exercises(ROOT):
+            with open(os.path.join(student, "tests", f"step{e.step:02d}_fake.cpp"), "a") as f:
+                f.write(f'TEST_SUITE("exercise {e.id}") {{ TEST_CASE("fake {e.id}") {{}} }}\n')
+            path = os.path.join(student, e.path)
+            with open(path, encoding="utf-8") as f:
+                text = f.read()
+            with open(path, "w", encoding="utf-8") as f:
+                f.write(text.replace(f"EXERCISE {e.id}:", f"EXERCISE {e.id}: (100 points)//", 1))
         out, results = grade(student, work, [first], os.path.join(work, "kit.xml"))
     ids = [e.id for e in exercises(ROOT) if f"{e.step:02d}" == first]
     for i in ids:
@@ -183,6 +195,37 @@ def scenario_compile_error(work):
         print("note: only one step has exercises; the other steps' scores are checked once there are more")
 
 
+def scenario_hidden(work):
+    """An instructor's hidden tests count for their exercise, and a test case that hangs is
+    stopped by the time limit."""
+    first = steps_with_exercises()[0]
+    ids = [e.id for e in exercises(ROOT) if f"{e.step:02d}" == first]
+    failing, hanging = ids[0], ids[-1]
+    with tempfile.TemporaryDirectory() as hidden:
+        with open(os.path.join(hidden, f"step{first}_hidden.cpp"), "w") as f:
+            f.write("#include <doctest/doctest.h>\n#include <chrono>\n#include <thread>\n"
+                    f'TEST_SUITE("exercise {failing}") {{\n'
+                    '    TEST_CASE("hidden: an instructor check") { CHECK(1 + 1 == 3); }\n}\n'
+                    f'TEST_SUITE("exercise {hanging}") {{\n'
+                    '    TEST_CASE("hidden: a test that never ends") {\n'
+                    "        for (;;) std::this_thread::sleep_for(std::chrono::milliseconds(10));\n"
+                    "    }\n}\n")
+        cmd = [sys.executable, os.path.join(ROOT, "tools", "grade.py"), ROOT, "--work", work,
+               "--steps", first, "--junit", os.path.join(work, "hidden.xml"), "--timeout", "3",
+               "--hidden", hidden]
+        r = subprocess.run(cmd, capture_output=True, text=True)
+    print(r.stdout, r.stderr)
+    check(r.returncode == 0, "grade.py with --hidden exits 0")
+    lines = {l.split()[0]: l for l in r.stdout.splitlines() if l[:1].isdigit()}
+    check("hidden: an instructor check" in lines.get(failing, "") and "FAILED" in lines.get(failing, ""),
+          f"hidden: exercise {failing} fails on the hidden check")
+    check("timed out after 3 s" in lines.get(hanging, ""), f"hidden: exercise {hanging} times out")
+    others = [i for i in ids if i not in (failing, hanging)]
+    check(all("passed" in lines.get(i, "") for i in others), "hidden: the other exercises pass")
+    expected = points(others)
+    check(f"Grade: {expected} of {points(ids)} points" in r.stdout, f"hidden: {expected} points")
+
+
 def main():
     if len(sys.argv) != 3:
         print(__doc__, file=sys.stderr)
@@ -190,7 +233,8 @@ def main():
     scenario, work = sys.argv[1], os.path.abspath(sys.argv[2])
     os.makedirs(work, exist_ok=True)
     {"kit": scenario_kit, "reference": scenario_reference, "kit-zero": scenario_kit_zero,
-     "one-solved": scenario_one_solved, "compile-error": scenario_compile_error}[scenario](work)
+     "one-solved": scenario_one_solved, "compile-error": scenario_compile_error,
+     "hidden": scenario_hidden}[scenario](work)
     print(f"{len(failures)} failed" if failures else "all checks passed")
     return 1 if failures else 0
 

@@ -188,14 +188,29 @@ def list_cases(binary):
     return [(c.get("testsuite", ""), c.get("name", "")) for c in root.iter("TestCase")]
 
 
-def run_case(binary, suite, name, timeout, cwd):
-    """(passed, message) for one test case, in its own process with a time limit."""
-    cmd = [binary, f"--test-suite={suite}", f"--test-case={name}", "--reporters=xml",
-           "--no-version"]
+def sandbox_prefix(cwd, work):
+    """bubblewrap around the student's code where it works: the file system read-only but
+    for a private /tmp and the working folder, no network. [] when it is not available."""
+    bwrap = shutil.which("bwrap")
+    if not bwrap:
+        return []
+    prefix = [bwrap, "--ro-bind", "/", "/", "--dev", "/dev", "--proc", "/proc", "--tmpfs", "/tmp",
+              "--ro-bind", work, work, "--bind", cwd, cwd, "--unshare-net", "--unshare-pid", "--die-with-parent"]
     try:
-        p = subprocess.Popen(cmd, cwd=cwd, stdout=subprocess.PIPE, stderr=subprocess.DEVNULL,
+        ok = subprocess.run(prefix + ["true"], capture_output=True, timeout=30).returncode == 0
+    except (OSError, subprocess.TimeoutExpired):
+        ok = False
+    return prefix if ok else []
+
+
+def run_case(binary, suite, name, timeout, cwd, sandbox=()):
+    """(passed, message) for one test case, in its own process with a time limit."""
+    cmd = list(sandbox) + [binary, f"--test-suite={suite}", f"--test-case={name}",
+                           "--reporters=xml", "--no-version"]
+    try:
+        p = subprocess.Popen(cmd, cwd=cwd, stdout=subprocess.PIPE, stderr=subprocess.PIPE,
                              stdin=subprocess.DEVNULL, text=True, start_new_session=True)
-        out, _ = p.communicate(timeout=timeout)
+        out, err = p.communicate(timeout=timeout)
     except subprocess.TimeoutExpired:
         os.killpg(p.pid, signal.SIGKILL)
         p.communicate()
@@ -204,7 +219,8 @@ def run_case(binary, suite, name, timeout, cwd):
         return False, f"crashed ({signal.Signals(-p.returncode).name})"
     results = [r for r in case_results(out) if r.name == name]
     if not results:
-        return False, f"no result (exit code {p.returncode})"
+        last = (err.strip().splitlines() or [""])[-1][:200]
+        return False, f"no result (exit code {p.returncode}) {last}".strip()
     return results[0].passed, results[0].message
 
 
@@ -276,6 +292,10 @@ def grade(args):
     configure(work)
     rows = []
     with tempfile.TemporaryDirectory(prefix="boxes-grade-") as cwd:
+        sandbox = [] if args.no_sandbox else sandbox_prefix(cwd, work)
+        if not sandbox:
+            notes.append("tests ran without a sandbox" + ("" if args.no_sandbox else
+                         " (bubblewrap is missing or cannot run here)"))
         for number in steps:
             items = [e for e in all_ex if f"{e.step:02d}" == number]
             say(f"step {number}: building test_step{number}")
@@ -292,7 +312,7 @@ def grade(args):
                         notes.append(f"suite '{suite}' has no exercise marker: not counted")
                         results[ex] = []
                     c0 = time.monotonic()
-                    passed, message = run_case(binary, suite, name, args.timeout, cwd)
+                    passed, message = run_case(binary, suite, name, args.timeout, cwd, sandbox)
                     results[ex].append((name, passed, message, time.monotonic() - c0))
             for e in items:
                 cases = results[e.id]
@@ -327,6 +347,8 @@ def main(argv):
     p.add_argument("--steps", help="grade only these steps, e.g. 01,03")
     p.add_argument("--work", help="where the grading tree and its build live (default build/grade)")
     p.add_argument("--jobs", type=int, default=2, help="parallel compile jobs (default 2)")
+    p.add_argument("--no-sandbox", action="store_true",
+                   help="run the tests without bubblewrap (read-only files, no network)")
     args = p.parse_args(argv)
     if args.timeout <= 0:
         p.error("--timeout must be positive")

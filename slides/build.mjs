@@ -19,6 +19,7 @@
 //                                                     a measured table (first alternative found)
 //   <!-- fact: 01_triangle/name -->                   one number from the report's facts
 //   <!-- machine -->                                  the machine the deck's numbers come from
+//   <!-- exercises: 01_triangle -->                  the step's exercise markers as a table
 //   <!-- code: 01_triangle NAME|EXERCISE 1.4 [max=N] [nocomments] -->
 //                                                     a function from the step's sources
 // A step that does not exist (or whose program fails) gets a visible "not built yet" note.
@@ -318,13 +319,31 @@ function codeExcerpt(step, names, opts) {
   return `<p class="src">${exists ? `The excerpt (${esc(names)}) is not in steps/${esc(step)}'s sources under that name: read the step's sources.` : `The code excerpt appears here once steps/${esc(step)} exists.`}</p>`;
 }
 
+// The exercise markers "// EXERCISE N.M: what (P points)" in the step's sources, as a table.
+function exercisesHtml(step) {
+  const rows = [];
+  for (const file of sourceFiles(step)) {
+    for (const line of fs.readFileSync(file, "utf8").split("\n")) {
+      const m = line.match(/\/\/\s*EXERCISE\s+(\d+)\.(\d+):\s*(.*?)\s*\((\d+)\s+points?\)/);
+      if (m) rows.push({ major: Number(m[1]), minor: Number(m[2]), what: m[3], points: Number(m[4]), file: path.basename(file) });
+    }
+  }
+  if (!rows.length) return pending(step, "exercise list", fs.existsSync(path.join(root, "steps", step)) ? "no exercise markers found" : `steps/${step} does not exist yet`);
+  rows.sort((a, b) => a.major - b.major || a.minor - b.minor);
+  const dense = rows.length > 7 ? " dense" : "";
+  const body = rows.map((r) => `<tr><td>${r.major}.${r.minor}</td><td>${r.points}</td><td style="text-align:left">${esc(r.what)}</td><td style="text-align:left"><code>${esc(r.file)}</code></td></tr>`).join("");
+  const total = rows.reduce((a, r) => a + r.points, 0);
+  return `<div class="measured${dense}"><table><thead><tr><th>exercise</th><th>points</th><th>what</th><th>file</th></tr></thead><tbody>${body}</tbody></table><p class="caption">${rows.length} exercises, ${total} points, read from the markers in steps/${esc(step)}/ when the slides were built.</p></div>`;
+}
+
 // ---- decks ---------------------------------------------------------------------------------
 
 function expand(markdown, deck, args, deckDir) {
   const deckStep = /^\d\d_/.test(deck) ? deck : null;
-  return markdown.replace(/^[ \t]*<!--\s*(image|table|fact|machine|code):?\s*(.*?)\s*-->[ \t]*$/gm, (_, kind, rest) => {
+  return markdown.replace(/^[ \t]*<!--\s*(image|table|fact|machine|code|exercises):?\s*(.*?)\s*-->[ \t]*$/gm, (_, kind, rest) => {
     const words = [...rest.matchAll(/(\w+)="([^"]*)"|(\S+)/g)].map((m) => (m[3] !== undefined ? m[3] : `${m[1]}=${m[2]}`));
     if (kind === "machine") return machineHtml(deckStep, args);
+    if (kind === "exercises") return exercisesHtml(words[0]);
     if (kind === "code") {
       // code: STEP NAME|NAME... [options]; names may contain a space ("EXERCISE 1.4").
       const m = rest.match(/^(\S+)\s+(.*?)((\s+(max=\d+|nocomments))*)$/);

@@ -289,11 +289,22 @@ function findDefinition(lines, name) {
     if (end < 0) continue;
     let start = i;
     if (start > 0 && /^\s*template\s*</.test(lines[start - 1])) --start;
-    // Keep the comment lines right above (the exercise marker, the why), at most three.
-    for (let k = 0; k < 3 && start > 0 && /^\s*\/\//.test(lines[start - 1]); ++k) --start;
-    return [start, end];
+    // The comment block right above (the exercise marker, the why) when it is short;
+    // of a longer one only its exercise marker line.
+    let top = start;
+    while (top > 0 && /^\s*\/\//.test(lines[top - 1])) --top;
+    if (start - top <= 3) return [top, end];
+    const marker = lines.slice(top, start).findIndex((l) => /EXERCISE\s+\d/.test(l));
+    return marker < 0 ? [start, end] : [top + marker, end, top + marker];
   }
   return null;
+}
+
+// The first line after `from` that is not a comment: where the definition starts.
+function nextCode(lines, from) {
+  let i = from;
+  while (i < lines.length && /^\s*\/\//.test(lines[i])) ++i;
+  return i;
 }
 
 function codeExcerpt(step, names, opts) {
@@ -302,7 +313,9 @@ function codeExcerpt(step, names, opts) {
       const lines = fs.readFileSync(file, "utf8").split("\n");
       const found = findDefinition(lines, name);
       if (!found) continue;
-      let body = lines.slice(found[0], found[1] + 1).filter((l) => !/\/\/\s*(BEGIN|END) SOLUTION/.test(l));
+      // found: [first, last] or [marker, last, marker] when only the marker line is kept.
+      let body = found.length === 3 ? [lines[found[0]]].concat(lines.slice(nextCode(lines, found[0]), found[1] + 1)) : lines.slice(found[0], found[1] + 1);
+      body = body.filter((l) => !/\/\/\s*(BEGIN|END) SOLUTION/.test(l));
       if (opts.nocomments) body = body.filter((l, i) => i === 0 || !/^\s*\/\/(?!\s*EXERCISE)/.test(l));
       const indent = Math.min(...body.filter((l) => l.trim()).map((l) => l.match(/^\s*/)[0].length));
       body = body.map((l) => l.slice(indent));
@@ -333,7 +346,7 @@ function exercisesHtml(step) {
   const dense = rows.length > 7 ? " dense" : "";
   const body = rows.map((r) => `<tr><td>${r.major}.${r.minor}</td><td>${r.points}</td><td style="text-align:left">${esc(r.what)}</td><td style="text-align:left"><code>${esc(r.file)}</code></td></tr>`).join("");
   const total = rows.reduce((a, r) => a + r.points, 0);
-  return `<div class="measured${dense}"><table><thead><tr><th>exercise</th><th>points</th><th>what</th><th>file</th></tr></thead><tbody>${body}</tbody></table><p class="caption">${rows.length} exercises, ${total} points, read from the markers in steps/${esc(step)}/ when the slides were built.</p></div>`;
+  return `<div class="measured exercises${dense}"><table><thead><tr><th>exercise</th><th>points</th><th>what</th><th>file</th></tr></thead><tbody>${body}</tbody></table><p class="caption">${rows.length} exercises, ${total} points, read from the markers in steps/${esc(step)}/ when the slides were built.</p></div>`;
 }
 
 // ---- decks ---------------------------------------------------------------------------------

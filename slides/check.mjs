@@ -131,7 +131,7 @@ try {
     );
     for (const src of badImages) failures.push(`image does not load: ${src}`);
     const imageCount = await page.evaluate(() => document.images.length);
-    const tableCount = await page.evaluate(() => document.querySelectorAll(".measured table").length);
+    const tableCount = await page.evaluate(() => document.querySelectorAll(".measured:not(.exercises) table").length);
 
     let formulaSlide = 0, formulas = 0;
     for (let i = 1; i <= slides; ++i) {
@@ -154,6 +154,13 @@ try {
       }
     }
     if (!formulas) failures.push("no formula rendered anywhere in the deck");
+    // Once a step exists and has been run, its deck must show its picture and its numbers.
+    const reportPath = path.join(args.out, `${name}.json`);
+    if (/^\d\d_/.test(name) && fs.existsSync(path.join(root, "steps", name)) && fs.existsSync(reportPath)) {
+      const report = JSON.parse(fs.readFileSync(reportPath, "utf8"));
+      if ((report.images || []).length && imageCount === 0) failures.push("the step rendered images, but the deck shows none");
+      if ((report.tables || []).length && tableCount === 0) failures.push("the step measured tables, but the deck shows none");
+    }
     const pdf = path.join(deckDir, `${name}.pdf`);
     if (args.pdf && !(fs.existsSync(pdf) && fs.statSync(pdf).size > 1000)) failures.push(`${path.relative(root, pdf)} missing or empty`);
     results.push({ name, failures, slides, imageCount, tableCount, formulas, formulaSlide });

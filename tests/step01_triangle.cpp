@@ -118,7 +118,7 @@ TEST_SUITE("exercise 1.3") {
 // The three full tests must agree on these worked numbers.
 template <typename Real>
 void checkWorkedHits(TriangleTest test) {
-    INFO(triangleTestName(test) << (sizeof(Real) == 4 ? " in float" : " in double"));
+    INFO(std::string(triangleTestName(test)) << (sizeof(Real) == 4 ? " in float" : " in double"));
     RayT<Real> down({Real(0.2), Real(0.3), Real(2)}, {0, 0, -1});
     auto h = intersectTriangle(test, down, cast<Real>(kUnit));
     REQUIRE(h.has_value());
@@ -143,7 +143,7 @@ void checkWorkedHits(TriangleTest test) {
 
 // Hard cases every full test must pass; `exact` tests must also close every crack.
 void checkHardCases(TriangleTest test) {
-    INFO(triangleTestName(test));
+    INFO(std::string(triangleTestName(test)));
     SUBCASE("hard case: a degenerate triangle misses without NaN") {
         for (const Triangled& t : {Triangled{{0, 0, 0}, {1, 0, 0}, {2, 0, 0}},
                                    Triangled{{0, 0, 0}, {0, 0, 0}, {0, 1, 0}},

@@ -412,10 +412,10 @@ TEST_SUITE("program 03") {
     }
     TEST_CASE("window: scripted frames with key presses under the offscreen video driver") {
         test::TempDir dir;
-        auto run = test::runProgram(
-            program,
-            "--width 64 --height 48 --frames 4 --keys b,Left,b --screenshot shot.png" + small, dir,
-            "SDL_VIDEODRIVER=offscreen");
+        auto run = test::runProgram(program,
+                                    "--scene spheres --width 64 --height 48 --frames 4 --keys "
+                                    "b,Left,b --screenshot shot.png",
+                                    dir, "SDL_VIDEODRIVER=offscreen");
         INFO(run.err);
         REQUIRE(run.exitCode == 0);
         CHECK(test::pngSize(dir.file("shot.png")).first > 0);

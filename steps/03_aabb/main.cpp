@@ -87,7 +87,7 @@ int main(int argc, char** argv) {
                       << ", " << formatSeconds(renderSeconds) << ")\n";
             if (measure) {
                 std::cerr << "03_aabb: slab tests on hard rays...\n";
-                for (Table& t : measureSlabTests(makeHardSlabRays(hardRays, opts.seed), 7))
+                for (Table& t : measureSlabTests(makeHardSlabRays(hardRays, opts.seed), 15))
                     report.add(std::move(t));
                 RenderSettings small = settings;
                 small.width = measureWidth;

@@ -64,46 +64,48 @@ std::vector<Table> measureSlabTests(const std::vector<HardSlabRay>& rays, int re
     }
     const auto& categories = hardSlabCategories();
     std::vector<std::vector<long long>> wrong(categories.size(), std::vector<long long>(5, 0));
+    // Timing: the variants take turns within every repeat, so a busy machine slows them
+    // alike; each sample is one pass over all the rays with the variant's own loop.
+    std::vector<std::vector<double>> samples(std::size(kAllSlabVariants));
+    auto pass = [&](SlabVariant v) {
+        auto loop = [&](auto test) {
+            Stopwatch watch;
+            long long h = 0;
+            for (size_t i = 0; i < rays.size(); ++i) h += test(i);
+            keepValue(h);
+            return watch.seconds();
+        };
+        switch (v) {
+            case SlabVariant::Naive:
+                return loop(
+                    [&](size_t i) { return intersectSlabsNaive(plain[i], boxes[i]).has_value(); });
+            case SlabVariant::NaiveSwapped:
+                return loop([&](size_t i) {
+                    return intersectSlabsNaive(plain[i], boxes[i], true).has_value();
+                });
+            case SlabVariant::StandIn:
+                return loop([&](size_t i) {
+                    return intersectSlabsStandIn(plain[i], boxes[i]).has_value();
+                });
+            case SlabVariant::Robust:
+                return loop(
+                    [&](size_t i) { return intersectSlabs(prepared[i], boxes[i]).has_value(); });
+            default:
+                return loop([&](size_t i) {
+                    return intersectSlabsConservative(prepared[i], boxes[i]).has_value();
+                });
+        }
+    };
+    for (int r = 0; r < repeats; ++r)
+        for (SlabVariant v : kAllSlabVariants) samples[size_t(v)].push_back(pass(v));
     for (SlabVariant v : kAllSlabVariants) {
+        Timing timing = summarize(samples[size_t(v)]);
         long long falseMiss = 0, falseHit = 0;
         for (size_t i = 0; i < rays.size(); ++i) {
             bool got = slabHit(v, plain[i], prepared[i], boxes[i]);
             if (got == rays[i].exact) continue;
             (got ? falseHit : falseMiss) += 1;
             ++wrong[size_t(rays[i].category)][size_t(v)];
-        }
-        // Each variant timed in its own loop, so the switch is outside the loop.
-        auto timeLoop = [&](auto test) {
-            return measureBatched(repeats, [&] {
-                long long h = 0;
-                for (size_t i = 0; i < rays.size(); ++i) h += test(i);
-                keepValue(h);
-            });
-        };
-        Timing timing;
-        switch (v) {
-            case SlabVariant::Naive:
-                timing = timeLoop(
-                    [&](size_t i) { return intersectSlabsNaive(plain[i], boxes[i]).has_value(); });
-                break;
-            case SlabVariant::NaiveSwapped:
-                timing = timeLoop([&](size_t i) {
-                    return intersectSlabsNaive(plain[i], boxes[i], true).has_value();
-                });
-                break;
-            case SlabVariant::StandIn:
-                timing = timeLoop([&](size_t i) {
-                    return intersectSlabsStandIn(plain[i], boxes[i]).has_value();
-                });
-                break;
-            case SlabVariant::Robust:
-                timing = timeLoop(
-                    [&](size_t i) { return intersectSlabs(prepared[i], boxes[i]).has_value(); });
-                break;
-            default:
-                timing = timeLoop([&](size_t i) {
-                    return intersectSlabsConservative(prepared[i], boxes[i]).has_value();
-                });
         }
         double scale = 1e9 / double(rays.size());
         accuracy.row(

@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <random>
+#include <stdexcept>
 
 #include "core/timing.hpp"
 
@@ -40,6 +41,8 @@ std::vector<int> BoxSet::materialsUsed() const {
 }
 
 BoxSet::Nearest BoxSet::nearest(const Ray& rayIn, BoxMethod method) const {
+    if (method == BoxMethod::SixPlanes && planes_.size() != boxes_.size())
+        throw std::logic_error("BoxSet: setMethod(SixPlanes) prepares the planes; call it first");
     Ray ray = rayIn;
     Nearest best;
     for (size_t i = 0; i < boxes_.size(); ++i) {

@@ -46,7 +46,9 @@ std::vector<Table> measureSlabTests(const std::vector<HardSlabRay>& rays, int re
         std::to_string(rays.size()) +
         " hard rays (see slab_hard_rays); exact answers in 64-bit integers on a dyadic grid; "
         "a false miss loses geometry behind a box, a false hit only costs time; "
-        "the naive tests divide, the others use 1/D precomputed per ray as a BVH does";
+        "the naive tests divide, the others use 1/D precomputed per ray as a BVH does; median "
+        "of " +
+        std::to_string(repeats) + " repeats with the variants taking turns in each, one thread";
     Table byCategory;
     byCategory.id = "slab_hard_rays";
     byCategory.title = "Wrong answers per kind of hard ray (false misses + false hits)";

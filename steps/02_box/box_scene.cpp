@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <random>
+#include <stdexcept>
 
 #include "core/timing.hpp"
 
@@ -40,6 +41,8 @@ std::vector<int> BoxSet::materialsUsed() const {
 }
 
 BoxSet::Nearest BoxSet::nearest(const Ray& rayIn, BoxMethod method) const {
+    if (method == BoxMethod::SixPlanes && planes_.size() != boxes_.size())
+        throw std::logic_error("BoxSet: setMethod(SixPlanes) prepares the planes; call it first");
     Ray ray = rayIn;
     Nearest best;
     for (size_t i = 0; i < boxes_.size(); ++i) {
@@ -199,61 +202,82 @@ using Real = long double;  // the reference: the slab method in x87 extended pre
 
 }  // namespace
 
+namespace {
+
+// One method in one precision: its rays, boxes and planes, and a timed pass over them.
+template <typename T>
+struct BoxVariant {
+    BoxMethod method;
+    std::vector<RayT<T>> rays;
+    std::vector<OrientedBoxT<T>> boxes;
+    std::vector<std::array<PlaneT<T>, 6>> planes;
+    const BoxRaySet* set;
+
+    BoxVariant(BoxMethod m, const BoxRaySet& s) : method(m), set(&s) {
+        for (const BoxRay& r : s.rays) rays.push_back(r.ray.as<T>());
+        for (const OrientedBox& b : s.boxes) {
+            boxes.push_back(castBox<T>(b));
+            planes.push_back(boxFacePlanes(boxes.back()));
+        }
+    }
+    std::optional<BoxHit<T>> test(size_t i) const {
+        uint32_t b = set->rays[i].box;
+        return method == BoxMethod::SixPlanes ? intersectSixPlanes(rays[i], planes[b])
+                                              : intersectBoxSlabs(rays[i], boxes[b]);
+    }
+    double pass(long long& hits) const {
+        Stopwatch watch;
+        long long h = 0;
+        for (size_t i = 0; i < rays.size(); ++i) h += test(i).has_value();
+        keepValue(h);
+        hits = h;
+        return watch.seconds();
+    }
+};
+
+}  // namespace
+
 std::vector<Table> measureBoxMethods(const BoxRaySet& set, int repeats) {
     Table speed;
     speed.id = "box_speed";
     speed.title = "Time per ray/box test: the six-plane method against the slab method";
     speed.columns = {"method", "precision", "ns/test", "min ns", "max ns", "hits"};
     speed.note = "median of repeats over " + std::to_string(set.rays.size()) +
-                 " rays at random oriented boxes (faces, edges, near misses, from inside); one "
-                 "thread; six planes use precomputed planes (exercise 2.1)";
+                 " rays at random oriented boxes (faces, edges, near misses, from inside); the "
+                 "variants take turns in every repeat; one thread; six planes use precomputed "
+                 "planes (exercise 2.1)";
     Table accuracy;
     accuracy.id = "box_accuracy";
     accuracy.title =
         "Accuracy against time: wrong answers of each method against a long double reference";
-    accuracy.columns = {"method",         "precision",  "ns/test",
-                        "wrong hit/miss", "wrong face", "max rel t error"};
+    accuracy.columns = {"variant", "ns/test", "wrong hit/miss", "wrong face", "max rel t error"};
     accuracy.note =
         "reference: the slab method in long double (64-bit mantissa) on the same "
         "float rays and boxes; a face counts as wrong only when the reference puts "
         "that face's plane at another t (on an edge both faces are right)";
 
-    // Reference answers, and the reference t of every face plane for the face check.
     std::vector<std::optional<BoxHit<Real>>> reference;
     std::vector<std::array<PlaneT<Real>, 6>> refPlanes;
     for (const OrientedBox& b : set.boxes) refPlanes.push_back(boxFacePlanes(castBox<Real>(b)));
     for (const BoxRay& r : set.rays)
         reference.push_back(intersectBoxSlabs(r.ray.as<Real>(), castBox<Real>(set.boxes[r.box])));
 
-    auto run = [&](BoxMethod method, auto precision) {
-        using T = decltype(precision);
-        std::vector<RayT<T>> rays;
-        std::vector<OrientedBoxT<T>> boxes;
-        std::vector<std::array<PlaneT<T>, 6>> planes;
-        for (const BoxRay& r : set.rays) rays.push_back(r.ray.as<T>());
-        for (const OrientedBox& b : set.boxes) {
-            boxes.push_back(castBox<T>(b));
-            planes.push_back(boxFacePlanes(boxes.back()));
-        }
-        std::vector<std::optional<BoxHit<T>>> answers(rays.size());
-        auto test = [&](size_t i) {
-            return method == BoxMethod::SixPlanes
-                       ? intersectSixPlanes(rays[i], planes[set.rays[i].box])
-                       : intersectBoxSlabs(rays[i], boxes[set.rays[i].box]);
-        };
-        long long hits = 0;
-        Timing timing = measureBatched(repeats, [&] {
-            long long h = 0;
-            for (size_t i = 0; i < rays.size(); ++i) h += test(i).has_value();
-            keepValue(h);
-            hits = h;
-        });
-        for (size_t i = 0; i < rays.size(); ++i) answers[i] = test(i);
+    BoxVariant<float> planesF(BoxMethod::SixPlanes, set), slabsF(BoxMethod::Slabs, set);
+    BoxVariant<double> planesD(BoxMethod::SixPlanes, set), slabsD(BoxMethod::Slabs, set);
+    std::vector<double> samples[4];
+    long long hits[4] = {0, 0, 0, 0};
+    for (int r = 0; r < repeats; ++r) {
+        samples[0].push_back(planesF.pass(hits[0]));
+        samples[1].push_back(planesD.pass(hits[1]));
+        samples[2].push_back(slabsF.pass(hits[2]));
+        samples[3].push_back(slabsD.pass(hits[3]));
+    }
+    auto grade = [&](const auto& variant, int index) {
         long long wrongHit = 0, wrongFace = 0;
         double maxT = 0.0;
-        for (size_t i = 0; i < rays.size(); ++i) {
+        for (size_t i = 0; i < variant.rays.size(); ++i) {
             const auto& ref = reference[i];
-            const auto& got = answers[i];
+            const auto got = variant.test(i);
             if (ref.has_value() != got.has_value()) {
                 ++wrongHit;
                 continue;
@@ -272,16 +296,18 @@ std::vector<Table> measureBoxMethods(const BoxRaySet& set, int repeats) {
             maxT = std::max(maxT, double(std::abs(Real(got->t) - tRef) /
                                          std::max(std::abs(tRef), Real(1e-30))));
         }
-        double scale = 1e9 / double(rays.size());
-        std::string name = boxMethodName(method), prec = sizeof(T) == 4 ? "float" : "double";
-        speed.row(
-            {name, prec, timing.median * scale, timing.min * scale, timing.max * scale, hits});
-        accuracy.row({name, prec, timing.median * scale, wrongHit, wrongFace, maxT});
+        Timing timing = summarize(samples[index]);
+        double scale = 1e9 / double(variant.rays.size());
+        std::string name = boxMethodName(variant.method);
+        std::string prec = index % 2 ? "double" : "float";
+        speed.row({name, prec, timing.median * scale, timing.min * scale, timing.max * scale,
+                   hits[index]});
+        accuracy.row({name + " " + prec, timing.median * scale, wrongHit, wrongFace, maxT});
     };
-    for (BoxMethod m : {BoxMethod::SixPlanes, BoxMethod::Slabs}) {
-        run(m, 0.0f);
-        run(m, 0.0);
-    }
+    grade(planesF, 0);
+    grade(planesD, 1);
+    grade(slabsF, 2);
+    grade(slabsD, 3);
     return {speed, accuracy};
 }
 

@@ -38,7 +38,8 @@ class BoxSet : public Geometry {
         int box = -1;
         BoxHit<float> hit{};
     };
-    // The nearest box along the ray with a given method (box = -1 on a miss).
+    // The nearest box along the ray with a given method (box = -1 on a miss). Six planes
+    // need their planes: setMethod(SixPlanes) once before (else std::logic_error).
     Nearest nearest(const Ray& ray, BoxMethod method) const;
     const std::vector<SceneBox>& boxes() const { return boxes_; }
 

@@ -130,7 +130,7 @@ int main(int argc, char** argv) {
                      "magenta: pixels where six planes and slabs see another box or face"});
                 std::cerr << "02_box: measuring both methods...\n";
                 BoxRaySet rays = makeBoxRays(64, raysPerBox, opts.seed);
-                for (Table& t : measureBoxMethods(rays, 7)) report.add(std::move(t));
+                for (Table& t : measureBoxMethods(rays, 11)) report.add(std::move(t));
                 Disagreement d = compareMethods(rays);
                 Table dis;
                 dis.id = "method_disagreement";

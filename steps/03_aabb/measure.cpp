@@ -1,0 +1,161 @@
+#include "03_aabb/measure.hpp"
+
+#include <iostream>
+
+#include "core/timing.hpp"
+
+namespace boxes {
+
+const char* slabVariantName(SlabVariant v) {
+    switch (v) {
+        case SlabVariant::Naive:
+            return "naive (the slide's)";
+        case SlabVariant::NaiveSwapped:
+            return "naive, min/max arguments swapped";
+        case SlabVariant::StandIn:
+            return "1e30 stand-in for 1/0";
+        case SlabVariant::Robust:
+            return "robust (3.6)";
+        default:
+            return "conservative (3.7)";
+    }
+}
+
+bool slabHit(SlabVariant v, const Ray& ray, const SlabRay& slabRay, const Bounds3f& box) {
+    switch (v) {
+        case SlabVariant::Naive:
+            return intersectSlabsNaive(ray, box).has_value();
+        case SlabVariant::NaiveSwapped:
+            return intersectSlabsNaive(ray, box, true).has_value();
+        case SlabVariant::StandIn:
+            return intersectSlabsStandIn(ray, box).has_value();
+        case SlabVariant::Robust:
+            return intersectSlabs(slabRay, box).has_value();
+        default:
+            return intersectSlabsConservative(slabRay, box).has_value();
+    }
+}
+
+std::vector<Table> measureSlabTests(const std::vector<HardSlabRay>& rays, int repeats) {
+    Table accuracy;
+    accuracy.id = "slab_accuracy";
+    accuracy.title = "Accuracy against time: slab tests on hard rays against the exact answer";
+    accuracy.columns = {"variant",      "ns/test",    "min ns",   "max ns",
+                        "false misses", "false hits", "wrong /1M"};
+    accuracy.note =
+        std::to_string(rays.size()) +
+        " hard rays (see slab_hard_rays); exact answers in 64-bit integers on a dyadic grid; "
+        "a false miss loses geometry behind a box, a false hit only costs time; "
+        "the naive tests divide, the others use 1/D precomputed per ray as a BVH does; median "
+        "of " +
+        std::to_string(repeats) + " repeats with the variants taking turns in each, one thread";
+    Table byCategory;
+    byCategory.id = "slab_hard_rays";
+    byCategory.title = "Wrong answers per kind of hard ray (false misses + false hits)";
+    byCategory.columns = {"rays", "count", "exact hits"};
+    for (SlabVariant v : kAllSlabVariants) byCategory.columns.push_back(slabVariantName(v));
+    byCategory.note = "each ray is tested against the one box it was made for";
+
+    std::vector<Ray> plain;
+    std::vector<SlabRay> prepared;
+    std::vector<Bounds3f> boxes;
+    for (const HardSlabRay& r : rays) {
+        plain.push_back(r.ray);
+        prepared.emplace_back(r.ray);
+        boxes.push_back(r.box);
+    }
+    const auto& categories = hardSlabCategories();
+    std::vector<std::vector<long long>> wrong(categories.size(), std::vector<long long>(5, 0));
+    // Timing: the variants take turns within every repeat, so a busy machine slows them
+    // alike; each sample is one pass over all the rays with the variant's own loop.
+    std::vector<std::vector<double>> samples(std::size(kAllSlabVariants));
+    auto pass = [&](SlabVariant v) {
+        auto loop = [&](auto test) {
+            Stopwatch watch;
+            long long h = 0;
+            for (size_t i = 0; i < rays.size(); ++i) h += test(i);
+            keepValue(h);
+            return watch.seconds();
+        };
+        switch (v) {
+            case SlabVariant::Naive:
+                return loop(
+                    [&](size_t i) { return intersectSlabsNaive(plain[i], boxes[i]).has_value(); });
+            case SlabVariant::NaiveSwapped:
+                return loop([&](size_t i) {
+                    return intersectSlabsNaive(plain[i], boxes[i], true).has_value();
+                });
+            case SlabVariant::StandIn:
+                return loop([&](size_t i) {
+                    return intersectSlabsStandIn(plain[i], boxes[i]).has_value();
+                });
+            case SlabVariant::Robust:
+                return loop(
+                    [&](size_t i) { return intersectSlabs(prepared[i], boxes[i]).has_value(); });
+            default:
+                return loop([&](size_t i) {
+                    return intersectSlabsConservative(prepared[i], boxes[i]).has_value();
+                });
+        }
+    };
+    for (int r = 0; r < repeats; ++r)
+        for (SlabVariant v : kAllSlabVariants) samples[size_t(v)].push_back(pass(v));
+    for (SlabVariant v : kAllSlabVariants) {
+        Timing timing = summarize(samples[size_t(v)]);
+        long long falseMiss = 0, falseHit = 0;
+        for (size_t i = 0; i < rays.size(); ++i) {
+            bool got = slabHit(v, plain[i], prepared[i], boxes[i]);
+            if (got == rays[i].exact) continue;
+            (got ? falseHit : falseMiss) += 1;
+            ++wrong[size_t(rays[i].category)][size_t(v)];
+        }
+        double scale = 1e9 / double(rays.size());
+        accuracy.row(
+            {std::string(slabVariantName(v)), timing.median * scale, timing.min * scale,
+             timing.max * scale, falseMiss, falseHit,
+             double(falseMiss + falseHit) * 1e6 / double(std::max<size_t>(1, rays.size()))});
+    }
+    for (size_t c = 0; c < categories.size(); ++c) {
+        long long count = 0, exactHits = 0;
+        for (const HardSlabRay& r : rays)
+            if (size_t(r.category) == c) ++count, exactHits += r.exact;
+        std::vector<Cell> row = {categories[c], count, exactHits};
+        for (long long w : wrong[c]) row.push_back(w);
+        byCategory.row(row);
+    }
+    return {accuracy, byCategory};
+}
+
+PretestResult measurePretest(ManyObjects& objects, const Camera& camera,
+                             const RenderSettings& settings) {
+    PretestResult result;
+    Table& t = result.table;
+    t.id = "pretest";
+    t.title = "Why we care: the scene rendered with and without a bounding-box pre-test";
+    t.columns = {"pre-test",      "ms/frame",        "rays", "primitive tests/ray",
+                 "box tests/ray", "pixels differing"};
+    t.note = std::to_string(settings.width) + "x" + std::to_string(settings.height) +
+             " pixels, one frame each (primary and shadow rays); boxes per sphere, per group of 8 "
+             "triangles and per mesh, conservative slab test (3.7); images compared exactly";
+    for (bool pretest : {false, true}) {
+        objects.setPretest(pretest);
+        objects.counts->reset();
+        RenderSettings s = settings;
+        s.progressLabel = pretest ? "03_aabb: with the pre-test" : "03_aabb: without the pre-test";
+        RayCounts rays;
+        Stopwatch watch;
+        Image image = renderImage(objects.scene, camera, s, &rays);
+        double ms = watch.milliseconds();
+        double n = double(std::max<uint64_t>(1, rays.total()));
+        (pretest ? result.with : result.without) = std::move(image);
+        if (pretest)
+            result.pixelsDiffering = compareImages(result.with, result.without).pixelsDiffering;
+        t.row({std::string(pretest ? "per sphere, group, mesh" : "none"), ms,
+               (long long)rays.total(), double(objects.counts->primitiveTests.load()) / n,
+               double(objects.counts->boxTests.load()) / n,
+               (long long)(pretest ? result.pixelsDiffering : 0)});
+    }
+    return result;
+}
+
+}  // namespace boxes

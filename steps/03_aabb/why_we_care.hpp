@@ -1,0 +1,90 @@
+// Why bounding boxes matter: scene objects that can test a ray against a box before they
+// test it against what is inside (per sphere, per small group of triangles, per mesh),
+// counting the tests, and a scene of thousands of spheres and triangles plus the bunny.
+#pragma once
+
+#include <atomic>
+#include <memory>
+#include <vector>
+
+#include "03_aabb/aabb.hpp"
+#include "core/scene.hpp"
+
+namespace boxes {
+
+// Tests made by the objects below, summed over every ray (one atomic add per ray and object).
+struct TestCounts {
+    std::atomic<uint64_t> boxTests{0}, primitiveTests{0};
+    void reset() {
+        boxTests = 0;
+        primitiveTests = 0;
+    }
+};
+
+// Spheres, each with its box (exercise 3.1) tested first when the pre-test is on.
+class SphereCloud : public Geometry {
+  public:
+    SphereCloud(std::vector<SceneSphere> spheres, std::shared_ptr<TestCounts> counts);
+    void setPretest(bool on) { pretest_ = on; }
+
+    bool intersect(const Ray& ray, SurfaceHit& hit) const override;
+    bool occluded(const Ray& ray) const override;
+    Vec3 boundsMin() const override { return all_.min; }
+    Vec3 boundsMax() const override { return all_.max; }
+    std::vector<int> materialsUsed() const override;
+    size_t size() const { return spheres_.size(); }
+
+  private:
+    std::vector<SceneSphere> spheres_;
+    std::vector<Bounds3f> bounds_;
+    Bounds3f all_;
+    std::shared_ptr<TestCounts> counts_;
+    bool pretest_ = true;
+};
+
+// Triangles intersected with step 01's watertight test. With the pre-test on, a ray first
+// meets the box of the whole mesh (exercise 3.3), then the box of each group of
+// `groupSize` triangles (exercises 3.2 and 3.4), and only then the triangles of the groups
+// it enters. Groups are runs of triangles sorted along a Morton curve of their centroids,
+// so a group's box is small. The boxes use the conservative slab test (exercise 3.7), so
+// the image is the same with and without the pre-test.
+class TriangleGroups : public Geometry {
+  public:
+    TriangleGroups(const Mesh& mesh, int material, std::shared_ptr<TestCounts> counts,
+                   int groupSize = 8);
+    void setPretest(bool on) { pretest_ = on; }
+
+    bool intersect(const Ray& ray, SurfaceHit& hit) const override;
+    bool occluded(const Ray& ray) const override;
+    Vec3 boundsMin() const override { return meshBox_.min; }
+    Vec3 boundsMax() const override { return meshBox_.max; }
+    std::vector<int> materialsUsed() const override { return {material_}; }
+    size_t size() const { return order_.size(); }
+    size_t groups() const { return groupBoxes_.size(); }
+
+  private:
+    Mesh mesh_;
+    int material_;
+    std::vector<uint32_t> order_;  // triangle indices, Morton order
+    std::vector<Bounds3f> groupBoxes_;
+    int groupSize_;
+    Bounds3f meshBox_;
+    std::shared_ptr<TestCounts> counts_;
+    bool pretest_ = true;
+};
+
+// The step's scene: a floor, `spheres` small spheres, `triangles` small triangles in
+// clusters of 8, and the bunny (data/meshes/bunny.obj, scaled by 1.5 and set on the floor).
+struct ManyObjects {
+    Scene scene;
+    std::shared_ptr<TestCounts> counts;
+    std::shared_ptr<SphereCloud> spheres;
+    std::vector<std::shared_ptr<TriangleGroups>> meshes;
+    void setPretest(bool on);
+};
+ManyObjects makeManyObjects(const std::string& dataDir, float aspect, size_t spheres = 3000,
+                            size_t triangles = 4000, bool bunny = true, uint64_t seed = 1);
+// Any core scene with its spheres and mesh moved into the objects above.
+ManyObjects wrapScene(Scene scene);
+
+}  // namespace boxes

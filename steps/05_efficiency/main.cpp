@@ -47,7 +47,7 @@ std::string slug(PreviewMode m) {
 
 // What the optimizations bought on this scene: the naive renderer (every effect traced,
 // lights without a radius, one thread) against the optimized one, step by step.
-Table totalSpeedup(const Scene& scene, int repeats) {
+Table totalSpeedup(const Scene& scene, int repeats, bool quick) {
     Table t;
     t.id = "total";
     t.title = "All together on the scene: time per frame as each optimization is switched on";
@@ -70,8 +70,8 @@ Table totalSpeedup(const Scene& scene, int repeats) {
                              Variant{"+ finite light radius", &scene, false, 1},
                              Variant{"+ all threads", &scene, false, 0}}) {
         RenderSettings s;
-        s.width = 160;
-        s.height = 120;
+        s.width = quick ? 40 : 160;
+        s.height = quick ? 30 : 120;
         s.threads = v.threads;
         s.forceAllEffects = v.force;
         Renderer r(*v.scene, v.scene->camera, s);
@@ -101,6 +101,8 @@ int main(int argc, char** argv) {
         app.add_option("--budget-ms", budgetMs, "refinement time budget per frame (window)")
             ->check(CLI::Range(1.0, 1000.0))
             ->capture_default_str();
+        bool quick = false;
+        app.add_flag("--quick", quick, "a quick lab: smaller images and fewer samples (for tests)");
         int photoSpp = 16, photoDepth = 12;
         app.add_option("--photo-spp", photoSpp, "photograph mode: samples per pixel")
             ->check(CLI::Range(1, 1024))
@@ -168,6 +170,7 @@ int main(int argc, char** argv) {
                 lab.threads = opts.threads;
                 lab.seed = opts.seed;
                 lab.dataDir = opts.dataDir;
+                lab.quick = quick;
                 Mesh bunny =
                     scene.hasMesh() ? scene.mesh : loadObj(opts.dataDir + "/meshes/bunny.obj");
                 auto step = [&](const char* what, auto&& f) {
@@ -187,7 +190,7 @@ int main(int argc, char** argv) {
                 step("threads", [&] { return measureThreads(scene, lab); });
                 step("anti-aliasing", [&] { return measureAntiAliasing(scene, lab); });
                 step("previews", [&] { return measurePreviews(scene, lab); });
-                step("all together", [&] { return totalSpeedup(scene, repeats); });
+                step("all together", [&] { return totalSpeedup(scene, repeats, quick); });
                 const Table& total = report.tables.back();
                 report.facts["total_speedup"] = std::get<double>(total.rows.back().back());
                 auto plot = [&](const char* table, const char* x, const char* y, const char* series,

@@ -15,6 +15,7 @@ struct LabOptions {
     int threads = 0;  // for the threads table only: every other table is one thread
     uint64_t seed = 1;
     std::string dataDir;
+    bool quick = false;  // a quarter of the image sizes and far fewer samples (tests)
 };
 
 Table measureMeasuring(const LabOptions& o);    // one call per sample against batches

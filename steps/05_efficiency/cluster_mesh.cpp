@@ -86,7 +86,7 @@ long ClusterMesh::nearest(const Ray& rayIn, TriangleHitT& best) const {
         // Every box the ray meets, in storage order; each of its triangles tested.
         for (const Cluster& c : clusters_) {
             ++boxes;
-            if (boxTest(ray, pre, c.box)) testCluster(c);
+            if (boxTest(rayIn, pre, c.box)) testCluster(c);
         }
     } else {
         // Early out for the nearest hit: visit the boxes the ray meets front to back and

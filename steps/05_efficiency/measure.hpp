@@ -3,6 +3,8 @@
 #pragma once
 
 #include <cstdint>
+#include <functional>
+#include <vector>
 
 #include "core/render.hpp"
 #include "core/report.hpp"
@@ -31,6 +33,10 @@ Table measureInverseSqrt(const LabOptions& o);
 Table measureThreads(const Scene& scene, const LabOptions& o);
 Table measureAntiAliasing(const Scene& scene, const LabOptions& o);
 Table measurePreviews(const Scene& scene, const LabOptions& o);
+
+// Times each function `repeats` times, one call of each per round (round-robin), so a
+// drift in the machine's load is shared by all of them. One Timing per function.
+std::vector<Timing> measureInterleaved(int repeats, const std::vector<std::function<void()>>& fns);
 
 // How work is handed to threads.
 enum class Schedule { StaticRows, DynamicRows, DynamicTiles };

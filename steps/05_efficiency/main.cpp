@@ -208,32 +208,39 @@ int main(int argc, char** argv) {
                 const Table& total = report.tables.back();
                 report.facts["total_speedup"] = std::get<double>(total.rows.back().back());
                 auto plot = [&](const char* table, const char* x, const char* y, const char* series,
-                                const char* title, bool logx, bool logy) {
+                                const char* title, bool logx, bool logy, bool lines = false) {
                     report.plots.push_back({{"table", table},
                                             {"x", x},
                                             {"y", y},
                                             {"series", series},
                                             {"title", title},
                                             {"logx", logx},
-                                            {"logy", logy}});
+                                            {"logy", logy},
+                                            {"lines", lines}});
                 };
+                plot("float_double", "offset", "max rel t error", "variant",
+                     "Float against double: the largest relative error in t as the scene moves "
+                     "away from the origin",
+                     true, true, true);
                 plot("float_double", "ns/test", "max rel t error", "variant",
-                     "Float against double: time per test and the largest relative error in t",
-                     false, true);
+                     "Float against double: time per test against the error in t", false, true);
                 plot("sincos", "ns/call", "max abs error", "variant",
                      "Sine: time per call against the largest error over the circle", false, true);
-                plot("antialiasing", "ms/frame", "RMSE", "samples/pixel",
+                plot("antialiasing", "ms/frame", "RMSE", "",
                      "Anti-aliasing: error against time for 1, 4, 16, 64 samples per pixel", true,
-                     true);
+                     true, true);
                 plot("threads", "threads", "speed-up", "schedule",
-                     "Threads: speed-up over one thread", false, false);
+                     "Threads: speed-up over one thread", false, false, true);
                 plot("precalc", "ms/frame", "triangle tests/pixel", "variant",
                      "Precalculation and early out: time per frame against the work per pixel",
-                     false, true);
+                     false, false);
                 plot("rsqrt", "ns/call", "max relative error", "variant",
                      "Reciprocal square root: time against error", false, true);
                 plot("previews", "ms/frame", "RMSE against full", "mode",
-                     "Preview modes: time per frame against the error of the preview", true, false);
+                     "Preview modes: time per frame against the error of the preview", false,
+                     false);
+                plot("total", "ms/frame", "ratio to naive", "variant",
+                     "All together: time per frame of the default scene", false, false);
             }
             report.write(opts.json ? std::cerr : std::cout, opts.json ? "-" : opts.reportPath);
             if (opts.json && !opts.reportPath.empty()) report.write(std::cerr, opts.reportPath);

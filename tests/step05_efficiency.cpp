@@ -434,6 +434,25 @@ TEST_SUITE("renderer 05") {
         CHECK(d.reflection == 0);
         CHECK(d.refraction == 0);
     }
+    TEST_CASE("finite light radius: within one 8-bit step of linear light and fewer evaluations") {
+        // 20 weak lights: beyond its radius each skipped light adds less than half a step, and
+        // few points are beyond more than one light's radius at a time.
+        Scene finite = makeScene("small-lights", {});
+        Scene infinite = finite;
+        for (auto& l : infinite.lights) l.radius = kInfinity<float>;
+        RenderSettings s;
+        s.width = 40;
+        s.height = 30;
+        RayCounts cf, ci;
+        Image a = renderImage(finite, finite.camera, s, &cf);
+        Image b = renderImage(infinite, infinite.camera, s, &ci);
+        ImageDifference d = compareImages(a, b);
+        INFO("max linear difference " << d.maxError * 255.0 << " / 255");
+        CHECK(d.maxError <= 1.0 / 255.0);
+        CHECK(cf.lightsOutOfRange > 0);
+        CHECK(ci.lightsOutOfRange == 0);
+        CHECK(cf.shadow < ci.shadow);
+    }
     TEST_CASE("cluster mesh: every optimization switch gives the same image") {
         Mesh mesh = loadObj(test::dataDir() + "/meshes/sh1.obj");
         auto cm = std::make_shared<ClusterMesh>(mesh, 0);

@@ -72,13 +72,7 @@ long ClusterMesh::nearest(const Ray& rayIn, TriangleHitT& best) const {
     PrecomputedRay pre = options_.reciprocal ? precomputeRay(ray) : PrecomputedRay{};
     uint64_t boxes = 0, tris = 0;
     long found = -1;
-    for (const Cluster& c : clusters_) {
-        ++boxes;
-        // With early out the box is tested against [tmin, nearest t so far]: a box entered
-        // beyond the nearest hit cannot hold a nearer one. Without, against the full ray.
-        if (options_.skipFarClusters) pre.tmax = ray.tmax;
-        Ray boxRay = options_.skipFarClusters ? ray : rayIn;
-        if (!boxTest(boxRay, pre, c.box)) continue;
+    auto testCluster = [&](const Cluster& c) {
         for (uint32_t i = c.begin; i < c.end; ++i) {
             ++tris;
             if (auto h = triangleTest(ray, i)) {
@@ -86,6 +80,27 @@ long ClusterMesh::nearest(const Ray& rayIn, TriangleHitT& best) const {
                 ray.tmax = h->t;
                 found = long(i);
             }
+        }
+    };
+    if (!options_.skipFarClusters) {
+        // Every box the ray meets, in storage order; each of its triangles tested.
+        for (const Cluster& c : clusters_) {
+            ++boxes;
+            if (boxTest(rayIn, pre, c.box)) testCluster(c);
+        }
+    } else {
+        // Early out for the nearest hit: visit the boxes the ray meets front to back and
+        // stop at the first box entered beyond the nearest hit found so far.
+        thread_local std::vector<std::pair<float, uint32_t>> entered;
+        entered.clear();
+        for (uint32_t k = 0; k < clusters_.size(); ++k) {
+            ++boxes;
+            if (auto t = boxTest(ray, pre, clusters_[k].box)) entered.push_back({*t, k});
+        }
+        std::sort(entered.begin(), entered.end());
+        for (const auto& [tEnter, k] : entered) {
+            if (tEnter > ray.tmax) break;
+            testCluster(clusters_[k]);
         }
     }
     boxTests_.fetch_add(boxes, std::memory_order_relaxed);

@@ -39,8 +39,11 @@ float SinTable::sinNearest(float radians) const {
     // BEGIN SOLUTION
     // Round to the nearest entry, then wrap: floor-based, so negative angles wrap too
     // (C++'s % keeps the sign of the dividend).
-    long index = long(std::floor(radians * perStep_ + 0.5f)) % n_;
-    if (index < 0) index += n_;
+    long index = long(std::floor(radians * perStep_ + 0.5f));
+    if (index < 0 || index >= n_) {  // the common case [0, 2 pi) skips the division
+        index %= n_;
+        if (index < 0) index += n_;
+    }
     return table_[size_t(index)];
     // END SOLUTION
 }
@@ -51,8 +54,11 @@ float SinTable::sinInterpolated(float radians) const {
     float position = radians * perStep_;
     float below = std::floor(position);
     float fraction = position - below;
-    long index = long(below) % n_;
-    if (index < 0) index += n_;
+    long index = long(below);
+    if (index < 0 || index >= n_) {
+        index %= n_;
+        if (index < 0) index += n_;
+    }
     // table_[n] repeats table_[0], so index + 1 never needs a wrap.
     float s0 = table_[size_t(index)], s1 = table_[size_t(index) + 1];
     return s0 + fraction * (s1 - s0);
@@ -158,18 +164,6 @@ PrecomputedTriangle precomputeTriangle(const TriangleVertices& tri) {
 std::optional<TriangleHitT> intersectPrecomputed(const Ray& ray, const PrecomputedTriangle& tri) {
     // BEGIN SOLUTION
     return mollerTrumbore(ray, tri.a, tri.e1, tri.e2);
-    // END SOLUTION
-}
-
-// EXERCISE 5.8: approximate 1/sqrt(x): the bit trick and one Newton step (1 point)
-float approxInverseSqrt(float x) {
-    // BEGIN SOLUTION
-    // Halving the exponent bits of x (shift right) and negating them approximates
-    // x^(-1/2) in the logarithmic domain; 0x5f3759df corrects the bias (Lomont 2003).
-    uint32_t bits = std::bit_cast<uint32_t>(x);
-    float y = std::bit_cast<float>(0x5f3759dfu - (bits >> 1));
-    // One Newton step on f(y) = 1/y^2 - x.
-    return y * (1.5f - 0.5f * x * y * y);
     // END SOLUTION
 }
 

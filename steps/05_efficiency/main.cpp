@@ -47,13 +47,14 @@ std::string slug(PreviewMode m) {
 
 // What the optimizations bought on this scene: the naive renderer (every effect traced,
 // lights without a radius, one thread) against the optimized one, step by step.
-Table totalSpeedup(const Scene& scene, int repeats) {
+Table totalSpeedup(const Scene& scene, int repeats, bool quick) {
     Table t;
     t.id = "total";
     t.title = "All together on the scene: time per frame as each optimization is switched on";
     t.columns = {"variant", "ms/frame", "min ms", "max ms", "ratio to naive"};
     t.note = "scene '" + scene.name +
-             "', 160x120, max depth 5, median of repeats; the mesh optimizations "
+             "', 160x120, max depth 5, median of repeats interleaved round-robin; the mesh "
+             "optimizations "
              "(precomputed data, early out) are in the precalc table";
     Scene infinite = scene;
     for (auto& l : infinite.lights) l.radius = kInfinity<float>;
@@ -63,22 +64,26 @@ Table totalSpeedup(const Scene& scene, int repeats) {
         bool force;
         int threads;
     };
-    double base = 0.0;
-    for (const Variant& v : {Variant{"naive: every effect forced, infinite light radius, 1 thread",
-                                     &infinite, true, 1},
-                             Variant{"+ effects on demand", &infinite, false, 1},
-                             Variant{"+ finite light radius", &scene, false, 1},
-                             Variant{"+ all threads", &scene, false, 0}}) {
+    std::vector<Variant> variants = {
+        {"naive: every effect forced, infinite light radius, 1 thread", &infinite, true, 1},
+        {"+ effects on demand", &infinite, false, 1},
+        {"+ finite light radius", &scene, false, 1},
+        {"+ all threads", &scene, false, 0}};
+    std::vector<std::unique_ptr<Renderer>> renderers;
+    std::vector<std::function<void()>> frames;
+    for (const Variant& v : variants) {
         RenderSettings s;
-        s.width = 160;
-        s.height = 120;
+        s.width = quick ? 40 : 160;
+        s.height = quick ? 30 : 120;
         s.threads = v.threads;
         s.forceAllEffects = v.force;
-        Renderer r(*v.scene, v.scene->camera, s);
-        Timing tm = measure(repeats, [&] { keepValue(r.render()); });
-        if (base == 0.0) base = tm.median;
-        t.row({std::string(v.name), tm.median * 1e3, tm.min * 1e3, tm.max * 1e3, base / tm.median});
+        renderers.push_back(std::make_unique<Renderer>(*v.scene, v.scene->camera, s));
+        frames.push_back([r = renderers.back().get()] { keepValue(r->render()); });
     }
+    std::vector<Timing> times = measureInterleaved(repeats, frames);
+    for (size_t i = 0; i < variants.size(); ++i)
+        t.row({std::string(variants[i].name), times[i].median * 1e3, times[i].min * 1e3,
+               times[i].max * 1e3, times[0].median / times[i].median});
     return t;
 }
 
@@ -101,6 +106,12 @@ int main(int argc, char** argv) {
         app.add_option("--budget-ms", budgetMs, "refinement time budget per frame (window)")
             ->check(CLI::Range(1.0, 1000.0))
             ->capture_default_str();
+        bool noPreviews = false;
+        app.add_flag("--no-previews", noPreviews,
+                     "headless: only the full render (no preview PNGs, no line-by-line check); for "
+                     "profiling one render");
+        bool quick = false;
+        app.add_flag("--quick", quick, "a quick lab: smaller images and fewer samples (for tests)");
         int photoSpp = 16, photoDepth = 12;
         app.add_option("--photo-spp", photoSpp, "photograph mode: samples per pixel")
             ->check(CLI::Range(1, 1024))
@@ -132,42 +143,48 @@ int main(int argc, char** argv) {
             RayCounts counts;
             Image image = renderImage(scene, camera, full, &counts);
             double seconds = watch.seconds();
-            // The same image line by line, as the window refines it: must be bit-identical.
-            Renderer renderer(scene, camera, settings);
-            RayCounts lineCounts;
-            IncrementalRenderer incremental(
-                settings.width, settings.height,
-                [&](Image& img, int row) { renderer.renderRows(img, row, row + 1, lineCounts); },
-                steadyClock());
-            int frames = 0;
-            while (!incremental.complete()) incremental.advance(budgetMs * 1e-3), ++frames;
-            bool identical = compareImages(incremental.image(), image).maxError == 0.0;
             image.writePng(out);
             report.images.push_back({out, "scene '" + scene.name + "', full render"});
-            for (PreviewMode m : kAllPreviewModes) {
-                if (m == PreviewMode::Full) continue;
-                std::string path = withSuffix(out, "-" + slug(m));
-                renderPreview(scene, camera, m, settings, 0.25f).writePng(path);
-                report.images.push_back({path, std::string("preview: ") + previewModeName(m)});
-            }
             report.facts["render_ms"] = seconds * 1e3;
             report.facts["rays"] = counts.total();
-            report.facts["refinement_frames"] = frames;
-            report.facts["refinement_budget_ms"] = budgetMs;
-            report.facts["refined_image_bit_identical"] = identical;
-            std::cerr << "05_efficiency: wrote " << out << " and " << report.images.size() - 1
-                      << " previews (" << image.width() << "x" << image.height() << ", "
-                      << formatSeconds(seconds) << "; refined in " << frames << " frames of "
-                      << budgetMs << " ms, " << (identical ? "bit-identical" : "NOT identical")
-                      << ")\n";
-            if (!identical)
-                throw std::runtime_error("the refined image differs from the direct render");
+            std::cerr << "05_efficiency: wrote " << out << " (" << image.width() << "x"
+                      << image.height() << ", " << formatSeconds(seconds) << ")\n";
+            if (!noPreviews) {
+                // The same image line by line, as the window refines it: must be bit-identical.
+                Renderer renderer(scene, camera, settings);
+                RayCounts lineCounts;
+                IncrementalRenderer incremental(
+                    settings.width, settings.height,
+                    [&](Image& img, int row) {
+                        renderer.renderRows(img, row, row + 1, lineCounts);
+                    },
+                    steadyClock());
+                int frames = 0;
+                while (!incremental.complete()) incremental.advance(budgetMs * 1e-3), ++frames;
+                bool identical = compareImages(incremental.image(), image).maxError == 0.0;
+                for (PreviewMode m : kAllPreviewModes) {
+                    if (m == PreviewMode::Full) continue;
+                    std::string path = withSuffix(out, "-" + slug(m));
+                    renderPreview(scene, camera, m, settings, 0.25f).writePng(path);
+                    report.images.push_back({path, std::string("preview: ") + previewModeName(m)});
+                }
+                report.facts["refinement_frames"] = frames;
+                report.facts["refinement_budget_ms"] = budgetMs;
+                report.facts["refined_image_bit_identical"] = identical;
+                std::cerr << "05_efficiency: wrote " << report.images.size() - 1
+                          << " previews; refined line by line in " << frames << " frames of "
+                          << budgetMs << " ms: " << (identical ? "bit-identical" : "NOT identical")
+                          << " to the direct render\n";
+                if (!identical)
+                    throw std::runtime_error("the refined image differs from the direct render");
+            }
             if (measure) {
                 LabOptions lab;
                 lab.repeats = repeats;
                 lab.threads = opts.threads;
                 lab.seed = opts.seed;
                 lab.dataDir = opts.dataDir;
+                lab.quick = quick;
                 Mesh bunny =
                     scene.hasMesh() ? scene.mesh : loadObj(opts.dataDir + "/meshes/bunny.obj");
                 auto step = [&](const char* what, auto&& f) {
@@ -187,36 +204,43 @@ int main(int argc, char** argv) {
                 step("threads", [&] { return measureThreads(scene, lab); });
                 step("anti-aliasing", [&] { return measureAntiAliasing(scene, lab); });
                 step("previews", [&] { return measurePreviews(scene, lab); });
-                step("all together", [&] { return totalSpeedup(scene, repeats); });
+                step("all together", [&] { return totalSpeedup(scene, repeats, quick); });
                 const Table& total = report.tables.back();
                 report.facts["total_speedup"] = std::get<double>(total.rows.back().back());
                 auto plot = [&](const char* table, const char* x, const char* y, const char* series,
-                                const char* title, bool logx, bool logy) {
+                                const char* title, bool logx, bool logy, bool lines = false) {
                     report.plots.push_back({{"table", table},
                                             {"x", x},
                                             {"y", y},
                                             {"series", series},
                                             {"title", title},
                                             {"logx", logx},
-                                            {"logy", logy}});
+                                            {"logy", logy},
+                                            {"lines", lines}});
                 };
+                plot("float_double", "offset", "max rel t error", "variant",
+                     "Float against double: the largest relative error in t as the scene moves "
+                     "away from the origin",
+                     true, true, true);
                 plot("float_double", "ns/test", "max rel t error", "variant",
-                     "Float against double: time per test and the largest relative error in t",
-                     false, true);
+                     "Float against double: time per test against the error in t", false, true);
                 plot("sincos", "ns/call", "max abs error", "variant",
                      "Sine: time per call against the largest error over the circle", false, true);
-                plot("antialiasing", "ms/frame", "RMSE", "samples/pixel",
+                plot("antialiasing", "ms/frame", "RMSE", "",
                      "Anti-aliasing: error against time for 1, 4, 16, 64 samples per pixel", true,
-                     true);
+                     true, true);
                 plot("threads", "threads", "speed-up", "schedule",
-                     "Threads: speed-up over one thread", false, false);
+                     "Threads: speed-up over one thread", false, false, true);
                 plot("precalc", "ms/frame", "triangle tests/pixel", "variant",
                      "Precalculation and early out: time per frame against the work per pixel",
-                     false, true);
+                     false, false);
                 plot("rsqrt", "ns/call", "max relative error", "variant",
                      "Reciprocal square root: time against error", false, true);
                 plot("previews", "ms/frame", "RMSE against full", "mode",
-                     "Preview modes: time per frame against the error of the preview", true, false);
+                     "Preview modes: time per frame against the error of the preview", false,
+                     false);
+                plot("total", "ms/frame", "ratio to naive", "variant",
+                     "All together: time per frame of the default scene", false, false);
             }
             report.write(opts.json ? std::cerr : std::cout, opts.json ? "-" : opts.reportPath);
             if (opts.json && !opts.reportPath.empty()) report.write(std::cerr, opts.reportPath);

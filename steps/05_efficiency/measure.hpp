@@ -3,6 +3,8 @@
 #pragma once
 
 #include <cstdint>
+#include <functional>
+#include <vector>
 
 #include "core/render.hpp"
 #include "core/report.hpp"
@@ -15,6 +17,7 @@ struct LabOptions {
     int threads = 0;  // for the threads table only: every other table is one thread
     uint64_t seed = 1;
     std::string dataDir;
+    bool quick = false;  // a quarter of the image sizes and far fewer samples (tests)
 };
 
 Table measureMeasuring(const LabOptions& o);    // one call per sample against batches
@@ -30,6 +33,10 @@ Table measureInverseSqrt(const LabOptions& o);
 Table measureThreads(const Scene& scene, const LabOptions& o);
 Table measureAntiAliasing(const Scene& scene, const LabOptions& o);
 Table measurePreviews(const Scene& scene, const LabOptions& o);
+
+// Times each function `repeats` times, one call of each per round (round-robin), so a
+// drift in the machine's load is shared by all of them. One Timing per function.
+std::vector<Timing> measureInterleaved(int repeats, const std::vector<std::function<void()>>& fns);
 
 // How work is handed to threads.
 enum class Schedule { StaticRows, DynamicRows, DynamicTiles };

@@ -754,8 +754,9 @@ Checked checkAnswer(const Part& part, const std::string& answer) {
     if (part.expected.empty()) return {Verdict::Wrong, "there is none"};
     for (size_t i = 0; i < got.size(); ++i)
         if (!withinTolerance(got[i], part.expected[i]))
-            return {Verdict::Wrong, "number " + std::to_string(i + 1) + " is " + num(got[i]) +
-                                        ", expected " + num(part.expected[i])};
+            return {Verdict::Wrong, (got.size() == 1 ? std::string("you gave ")
+                                                     : "number " + std::to_string(i + 1) + " is ") +
+                                        num(got[i]) + ", not " + num(part.expected[i])};
     return {Verdict::Correct, ""};
 }
 

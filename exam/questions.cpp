@@ -752,6 +752,15 @@ Checked checkAnswer(const Part& part, const std::string& answer) {
                                          (part.count == 1 ? "" : "s") + ", read " +
                                          std::to_string(got.size())};
     if (part.expected.empty()) return {Verdict::Wrong, "there is none"};
+    if (got.size() == 3) {
+        // A unit answer given unnormalized: say so, it is the most common slip.
+        Vec3d g(got[0], got[1], got[2]), e(part.expected[0], part.expected[1], part.expected[2]);
+        double lg = glm::length(g);
+        if (std::abs(glm::length(e) - 1.0) < 1e-9 && lg > 0.0 &&
+            std::abs(lg - 1.0) > kAbsoluteTolerance && glm::length(g / lg - e) < kAbsoluteTolerance)
+            return {Verdict::Wrong,
+                    "the right direction, but not of unit length: divide by " + num(lg)};
+    }
     for (size_t i = 0; i < got.size(); ++i)
         if (!withinTolerance(got[i], part.expected[i]))
             return {Verdict::Wrong, (got.size() == 1 ? std::string("you gave ")

@@ -104,6 +104,9 @@ TEST_SUITE("exam practice") {
         CHECK(checkAnswer(q.parts[0], "(2.17, 1, 2.17)").verdict == Verdict::Wrong);
         CHECK(checkAnswer(q.parts[0], "2.162 1").verdict == Verdict::Unreadable);
         CHECK(checkAnswer(q.parts[0], "none").verdict == Verdict::Unreadable);  // not allowed here
+        Checked unnormalized = checkAnswer(q.parts[1], "-1 0 -1");
+        CHECK(unnormalized.verdict == Verdict::Wrong);
+        CHECK(unnormalized.note.find("not of unit length") != std::string::npos);
         CHECK(checkAnswer(q.parts[3], "None").verdict == Verdict::Correct);
         CHECK(checkAnswer(q.parts[3], "no hit").verdict == Verdict::Correct);
         CHECK(checkAnswer(q.parts[2], "none").verdict == Verdict::Wrong);

@@ -274,11 +274,10 @@ def write_junit(path, rows, notes, seconds):
                 f.text = "\n".join(r["details"]) or r["message"]
             else:
                 ET.SubElement(c, "system-out").text = "\n".join(r["details"])
-    earned = sum(r["points"] for r in rows if r["passed"])
-    total = sum(r["points"] for r in rows)
-    ET.SubElement(suites, "properties")
-    out = ET.SubElement(suites, "system-out")
-    out.text = f"Grade: {earned} of {total} points\n" + "".join(f"note: {n}\n" for n in notes)
+        earned = sum(r["points"] for r in items if r["passed"])
+        ET.SubElement(s, "system-out").text = (
+            f"step {step}: {earned} of {sum(r['points'] for r in items)} points\n" +
+            "".join(f"note: {n}\n" for n in notes))
     ET.indent(suites)
     os.makedirs(os.path.dirname(os.path.abspath(path)), exist_ok=True)
     ET.ElementTree(suites).write(path, encoding="utf-8", xml_declaration=True)

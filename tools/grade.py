@@ -17,6 +17,8 @@ Each step's test program is built on its own, so a step that does not compile sc
 for its exercises (with the compiler's first error) and the other steps are still graded. Each
 test case of an "exercise N.M" suite runs as its own process with a time limit; an exercise
 earns its points (from the reference's markers) when it has test cases and all of them pass.
+The tests run under bubblewrap where it works (the files read-only but a private /tmp, no
+network) and write their results to a file, so what the student's code prints is not read.
 The points table goes to the terminal, a JUnit XML file to --junit (default WORK/grade.xml).
 WORK/build is kept between runs, so grading the next tree rebuilds only what changed.
 """
@@ -351,7 +353,8 @@ def grade(args):
 
 
 def main(argv):
-    p = argparse.ArgumentParser(prog="./workbook grade", description=__doc__.split("\n\n")[1],
+    p = argparse.ArgumentParser(prog="./workbook grade", description=__doc__.split("\n\n")[0],
+                                epilog="\n\n".join(__doc__.split("\n\n")[2:]),
                                 formatter_class=argparse.RawDescriptionHelpFormatter)
     p.add_argument("student", help="the student's workbook tree (a starter kit with their work)")
     p.add_argument("--hidden", help="folder of extra doctest files stepNN*.cpp")

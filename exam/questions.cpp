@@ -142,6 +142,17 @@ Question vectors(Rng& rng, Question q) {
                   "a x b = (ay bz - az by, az bx - ax bz, ax by - ay bx) = " + vec(cross),
                   "|a| = sqrt(ax^2 + ay^2 + az^2) = sqrt(" + num(glm::dot(a, a)) +
                       ") = " + num(glm::length(a)) + ", so a / |a| = " + vec(unit)};
+    // A combination k a + m b, component by component.
+    int k = rng.oneOf(std::vector<int>{-3, -2, 2, 3}),
+        m = rng.oneOf(std::vector<int>{-3, -2, -1, 1, 2});
+    q.given["k"] = {double(k)};
+    q.given["m"] = {double(m)};
+    Vec3d combination = double(k) * a + double(m) * b;
+    std::string name = std::to_string(k) + " a " + (m < 0 ? "- " : "+ ") +
+                       (std::abs(m) == 1 ? "" : std::to_string(std::abs(m)) + " ") + "b";
+    q.parts.push_back(numbersPart(name, values(combination), 3));
+    q.solution.push_back(name + " = " + vec(double(k) * a) + " + " + vec(double(m) * b) + " = " +
+                         vec(combination));
     return q;
 }
 

@@ -141,6 +141,9 @@ TEST_SUITE("exam practice") {
                                      a[0] * b[1] - a[1] * b[0]});
             checkValues(q.parts[2],
                         {a[0] / std::sqrt(len), a[1] / std::sqrt(len), a[2] / std::sqrt(len)});
+            double k = given1(q, "k"), m = given1(q, "m");
+            checkValues(q.parts[3],
+                        {k * a[0] + m * b[0], k * a[1] + m * b[1], k * a[2] + m * b[2]});
         }
     }
     TEST_CASE("generated questions: screen corners and primary rays re-derived by Gram-Schmidt") {

@@ -124,6 +124,7 @@ def scenario_kit(work):
         with open(os.path.join(dest, e.path), encoding="utf-8") as f:
             check(f'throw NotImplemented("{e.id}");' in f.read(), f"exercise {e.id} throws NotImplemented")
     check(not os.path.exists(os.path.join(dest, "build")), "no build output in the kit")
+    check(not os.path.exists(os.path.join(dest, "tools", "grade.py")), "no grading in the kit")
 
 
 def scenario_reference(work):

@@ -95,8 +95,6 @@ class Parser {
         return v;
     }
 
-    size_t position() const { return pos_; }
-
   private:
     const Token& peek() const { return tokens_[pos_]; }
     bool isSymbol(const char* s) const { return peek().kind == Token::Symbol && peek().text == s; }

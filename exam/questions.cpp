@@ -142,6 +142,17 @@ Question vectors(Rng& rng, Question q) {
                   "a x b = (ay bz - az by, az bx - ax bz, ax by - ay bx) = " + vec(cross),
                   "|a| = sqrt(ax^2 + ay^2 + az^2) = sqrt(" + num(glm::dot(a, a)) +
                       ") = " + num(glm::length(a)) + ", so a / |a| = " + vec(unit)};
+    // A combination k a + m b, component by component.
+    int k = rng.oneOf(std::vector<int>{-3, -2, 2, 3}),
+        m = rng.oneOf(std::vector<int>{-3, -2, -1, 1, 2});
+    q.given["k"] = {double(k)};
+    q.given["m"] = {double(m)};
+    Vec3d combination = double(k) * a + double(m) * b;
+    std::string name = std::to_string(k) + " a " + (m < 0 ? "- " : "+ ") +
+                       (std::abs(m) == 1 ? "" : std::to_string(std::abs(m)) + " ") + "b";
+    q.parts.push_back(numbersPart(name, values(combination), 3));
+    q.solution.push_back(name + " = " + vec(double(k) * a) + " + " + vec(double(m) * b) + " = " +
+                         vec(combination));
     return q;
 }
 
@@ -752,10 +763,20 @@ Checked checkAnswer(const Part& part, const std::string& answer) {
                                          (part.count == 1 ? "" : "s") + ", read " +
                                          std::to_string(got.size())};
     if (part.expected.empty()) return {Verdict::Wrong, "there is none"};
+    if (got.size() == 3) {
+        // A unit answer given unnormalized: say so, it is the most common slip.
+        Vec3d g(got[0], got[1], got[2]), e(part.expected[0], part.expected[1], part.expected[2]);
+        double lg = glm::length(g);
+        if (std::abs(glm::length(e) - 1.0) < 1e-9 && lg > 0.0 &&
+            std::abs(lg - 1.0) > kAbsoluteTolerance && glm::length(g / lg - e) < kAbsoluteTolerance)
+            return {Verdict::Wrong,
+                    "the right direction, but not of unit length: divide by " + num(lg)};
+    }
     for (size_t i = 0; i < got.size(); ++i)
         if (!withinTolerance(got[i], part.expected[i]))
-            return {Verdict::Wrong, "number " + std::to_string(i + 1) + " is " + num(got[i]) +
-                                        ", expected " + num(part.expected[i])};
+            return {Verdict::Wrong, (got.size() == 1 ? std::string("you gave ")
+                                                     : "number " + std::to_string(i + 1) + " is ") +
+                                        num(got[i]) + ", not " + num(part.expected[i])};
     return {Verdict::Correct, ""};
 }
 

@@ -104,6 +104,9 @@ TEST_SUITE("exam practice") {
         CHECK(checkAnswer(q.parts[0], "(2.17, 1, 2.17)").verdict == Verdict::Wrong);
         CHECK(checkAnswer(q.parts[0], "2.162 1").verdict == Verdict::Unreadable);
         CHECK(checkAnswer(q.parts[0], "none").verdict == Verdict::Unreadable);  // not allowed here
+        Checked unnormalized = checkAnswer(q.parts[1], "-1 0 -1");
+        CHECK(unnormalized.verdict == Verdict::Wrong);
+        CHECK(unnormalized.note.find("not of unit length") != std::string::npos);
         CHECK(checkAnswer(q.parts[3], "None").verdict == Verdict::Correct);
         CHECK(checkAnswer(q.parts[3], "no hit").verdict == Verdict::Correct);
         CHECK(checkAnswer(q.parts[2], "none").verdict == Verdict::Wrong);
@@ -138,6 +141,9 @@ TEST_SUITE("exam practice") {
                                      a[0] * b[1] - a[1] * b[0]});
             checkValues(q.parts[2],
                         {a[0] / std::sqrt(len), a[1] / std::sqrt(len), a[2] / std::sqrt(len)});
+            double k = given1(q, "k"), m = given1(q, "m");
+            checkValues(q.parts[3],
+                        {k * a[0] + m * b[0], k * a[1] + m * b[1], k * a[2] + m * b[2]});
         }
     }
     TEST_CASE("generated questions: screen corners and primary rays re-derived by Gram-Schmidt") {

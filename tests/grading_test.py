@@ -9,6 +9,7 @@ usage: tests/grading_test.py SCENARIO WORK_DIR
   compile-error  a step that does not compile scores zero with the compiler's error; the
                  other graded steps keep their points
   hidden         an instructor's hidden tests count, and a hanging test case times out
+  each-solved    (by hand, not in ctest) each exercise solved alone scores exactly its points
 
 The steps are discovered, not named: grading scenarios use the first step with exercises
 (and the last one for the compile error), so they keep working as steps are added. All
@@ -123,6 +124,7 @@ def scenario_kit(work):
         with open(os.path.join(dest, e.path), encoding="utf-8") as f:
             check(f'throw NotImplemented("{e.id}");' in f.read(), f"exercise {e.id} throws NotImplemented")
     check(not os.path.exists(os.path.join(dest, "build")), "no build output in the kit")
+    check(not os.path.exists(os.path.join(dest, "tools", "grade.py")), "no grading in the kit")
 
 
 def scenario_reference(work):
@@ -226,6 +228,21 @@ def scenario_hidden(work):
     check(f"Grade: {expected} of {points(ids)} points" in r.stdout, f"hidden: {expected} points")
 
 
+def scenario_each_solved(work):
+    """Not in ctest (a rebuild per exercise): every exercise solved alone in the kit scores
+    exactly its points, i.e. no exercise's tests lean on another exercise."""
+    for number in steps_with_exercises():
+        ids = [e.id for e in exercises(ROOT) if f"{e.step:02d}" == number]
+        for solved in ids:
+            with tempfile.TemporaryDirectory() as student:
+                student_tree(student, keep={solved})
+                out, results = grade(student, work, [number], os.path.join(work, "each.xml"))
+            wrong = [i for i in ids if results.get(i, (None,))[0] != (i == solved)]
+            check(not wrong, f"only {solved} solved: " + ("exactly its points" if not wrong else
+                  "; ".join(f"{i} {'fails' if i == solved else 'passes'}: {results.get(i, ('', ''))[1]}"
+                            for i in wrong)))
+
+
 def main():
     if len(sys.argv) != 3:
         print(__doc__, file=sys.stderr)
@@ -234,7 +251,7 @@ def main():
     os.makedirs(work, exist_ok=True)
     {"kit": scenario_kit, "reference": scenario_reference, "kit-zero": scenario_kit_zero,
      "one-solved": scenario_one_solved, "compile-error": scenario_compile_error,
-     "hidden": scenario_hidden}[scenario](work)
+     "hidden": scenario_hidden, "each-solved": scenario_each_solved}[scenario](work)
     print(f"{len(failures)} failed" if failures else "all checks passed")
     return 1 if failures else 0
 

@@ -17,6 +17,8 @@ Each step's test program is built on its own, so a step that does not compile sc
 for its exercises (with the compiler's first error) and the other steps are still graded. Each
 test case of an "exercise N.M" suite runs as its own process with a time limit; an exercise
 earns its points (from the reference's markers) when it has test cases and all of them pass.
+The tests run under bubblewrap where it works (the files read-only but a private /tmp, no
+network) and write their results to a file, so what the student's code prints is not read.
 The points table goes to the terminal, a JUnit XML file to --junit (default WORK/grade.xml).
 WORK/build is kept between runs, so grading the next tree rebuilds only what changed.
 """
@@ -160,10 +162,11 @@ def configure(work):
 
 def first_error(output, src):
     """The compiler's (or linker's) first error, one line, paths relative to the tree."""
-    for line in output.splitlines():
-        if re.search(r"\berror\b", line) and not line.startswith(("ninja:", "FAILED:")):
-            line = line.replace(src + "/", "")
-            return " ".join(line.split())[:400]
+    for pattern in (r": (fatal )?error:", r"undefined reference|ld returned", r"\berror\b"):
+        for line in output.splitlines():
+            if re.search(pattern, line) and not line.startswith(("ninja:", "FAILED:")):
+                line = line.replace(src + "/", "")
+                return " ".join(line.split())[:400]
     for line in output.splitlines():
         if line.startswith("FAILED:"):
             return line[:400]
@@ -181,10 +184,14 @@ def build_step(work, number, jobs):
     return False, first_error(r.stdout + r.stderr, os.path.join(work, "src"))
 
 
-def list_cases(binary):
-    r = subprocess.run([binary, "--list-test-cases", "--reporters=xml"], capture_output=True,
-                       text=True, timeout=60)
-    root = ET.fromstring(r.stdout)
+def list_cases(binary, sandbox):
+    """[(suite, test case)] of a test program, or raises RuntimeError saying why not."""
+    try:
+        r = subprocess.run(list(sandbox) + [binary, "--list-test-cases", "--reporters=xml"],
+                           capture_output=True, text=True, timeout=60)
+        root = ET.fromstring(r.stdout)
+    except (OSError, subprocess.TimeoutExpired, ET.ParseError) as e:
+        raise RuntimeError(f"the test program does not list its tests ({type(e).__name__})") from e
     return [(c.get("testsuite", ""), c.get("name", "")) for c in root.iter("TestCase")]
 
 
@@ -205,19 +212,23 @@ def sandbox_prefix(cwd, work):
 
 def run_case(binary, suite, name, timeout, cwd, sandbox=()):
     """(passed, message) for one test case, in its own process with a time limit."""
+    # The results go to a file, not stdout, so what the student's code prints is not read.
+    result = os.path.join(cwd, f"result-{os.getpid()}-{time.monotonic_ns()}.xml")
     cmd = list(sandbox) + [binary, f"--test-suite={suite}", f"--test-case={name}",
-                           "--reporters=xml", "--no-version"]
+                           "--reporters=xml", "--no-version", f"--out={result}"]
     try:
-        p = subprocess.Popen(cmd, cwd=cwd, stdout=subprocess.PIPE, stderr=subprocess.PIPE,
+        p = subprocess.Popen(cmd, cwd=cwd, stdout=subprocess.DEVNULL, stderr=subprocess.PIPE,
                              stdin=subprocess.DEVNULL, text=True, start_new_session=True)
-        out, err = p.communicate(timeout=timeout)
+        _, err = p.communicate(timeout=timeout)
     except subprocess.TimeoutExpired:
         os.killpg(p.pid, signal.SIGKILL)
         p.communicate()
         return False, f"timed out after {timeout:g} s"
     if p.returncode < 0:
         return False, f"crashed ({signal.Signals(-p.returncode).name})"
-    results = [r for r in case_results(out) if r.name == name]
+    results = [r for r in case_results(result) if r.name == name] if os.path.exists(result) else []
+    if os.path.exists(result):
+        os.remove(result)
     if not results:
         last = (err.strip().splitlines() or [""])[-1][:200]
         return False, f"no result (exit code {p.returncode}) {last}".strip()
@@ -265,11 +276,10 @@ def write_junit(path, rows, notes, seconds):
                 f.text = "\n".join(r["details"]) or r["message"]
             else:
                 ET.SubElement(c, "system-out").text = "\n".join(r["details"])
-    earned = sum(r["points"] for r in rows if r["passed"])
-    total = sum(r["points"] for r in rows)
-    ET.SubElement(suites, "properties")
-    out = ET.SubElement(suites, "system-out")
-    out.text = f"Grade: {earned} of {total} points\n" + "".join(f"note: {n}\n" for n in notes)
+        earned = sum(r["points"] for r in items if r["passed"])
+        ET.SubElement(s, "system-out").text = (
+            f"step {step}: {earned} of {sum(r['points'] for r in items)} points\n" +
+            "".join(f"note: {n}\n" for n in notes))
     ET.indent(suites)
     os.makedirs(os.path.dirname(os.path.abspath(path)), exist_ok=True)
     ET.ElementTree(suites).write(path, encoding="utf-8", xml_declaration=True)
@@ -304,7 +314,10 @@ def grade(args):
             results = {e.id: [] for e in items}
             if ok:
                 binary = os.path.join(work, "build", "tests", f"test_step{number}")
-                cases = [(s, n) for s, n in list_cases(binary) if s.startswith("exercise ")]
+                try:
+                    cases = [(s, n) for s, n in list_cases(binary, sandbox) if s.startswith("exercise ")]
+                except RuntimeError as e:
+                    ok, error, cases = False, str(e), []
                 say(f"step {number}: running {len(cases)} test cases")
                 for suite, name in cases:
                     ex = suite.split(" ", 1)[1]
@@ -319,6 +332,8 @@ def grade(args):
                 failed = [c for c in cases if not c[1]]
                 if not ok:
                     passed, message = False, f"step {number} does not build: {error}"
+                    if error.startswith("the test program"):
+                        message = f"step {number}: {error}"
                 elif not cases:
                     passed, message = False, "no test cases for this exercise"
                 else:
@@ -338,7 +353,8 @@ def grade(args):
 
 
 def main(argv):
-    p = argparse.ArgumentParser(prog="./workbook grade", description=__doc__.split("\n\n")[1],
+    p = argparse.ArgumentParser(prog="./workbook grade", description=__doc__.split("\n\n")[0],
+                                epilog="\n\n".join(__doc__.split("\n\n")[2:]),
                                 formatter_class=argparse.RawDescriptionHelpFormatter)
     p.add_argument("student", help="the student's workbook tree (a starter kit with their work)")
     p.add_argument("--hidden", help="folder of extra doctest files stepNN*.cpp")

@@ -1,6 +1,7 @@
 #!/usr/bin/python3
 """Writes a starter kit: a copy of the workbook's tracked files (git ls-files; no build
 output) with every solution block replaced by a stub that throws NotImplemented("N.M").
+Grading (tools/grade.py and its tests) stays out of the kit: it needs the solutions.
 
 usage: tools/kit.py DIR        (./workbook kit DIR)
 
@@ -19,6 +20,8 @@ from exercises import BEGIN, END, SOURCE_SUFFIXES, parse_file  # noqa: E402
 
 ROOT = os.path.dirname(os.path.dirname(os.path.abspath(__file__)))
 SKIP_DIRS = {".git", "build", "out", "kit", "node_modules", "__pycache__"}
+# Grading belongs to the instructor's reference tree: it needs the solutions.
+NOT_IN_KIT = {"tools/grade.py", "tests/grading_test.py"}
 
 
 def tracked_files(root):
@@ -57,7 +60,8 @@ def strip_solutions(text, path, root, keep=()):
     for ex in found:
         if ex.begin < 0 or ex.end < 0:
             raise SystemExit(f"kit: {ex.path}: exercise {ex.id} has no complete "
-                             "BEGIN SOLUTION ... END SOLUTION block")
+                             "BEGIN SOLUTION ... END SOLUTION block (is this tree a starter kit "
+                             "already? kits and grading start from the reference tree)")
     for ex in sorted(found, key=lambda e: -e.begin):
         indent = lines[ex.begin][: len(lines[ex.begin]) - len(lines[ex.begin].lstrip())]
         lines[ex.begin : ex.end + 1] = stub_lines(ex, indent)
@@ -97,6 +101,8 @@ def write_kit(dest, root=ROOT):
         raise SystemExit(f"kit: {dest} exists and is not empty; choose a new folder")
     stubbed = []
     for rel in tracked_files(root):
+        if rel in NOT_IN_KIT:
+            continue
         src, dst = os.path.join(root, rel), os.path.join(dest, rel)
         os.makedirs(os.path.dirname(dst), exist_ok=True)
         if rel.startswith("steps/") and rel.endswith(SOURCE_SUFFIXES):

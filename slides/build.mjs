@@ -127,7 +127,9 @@ function loadReport(step, args) {
 }
 
 function pending(step, what, error) {
-  return `<div class="pending">Step ${esc(step)}: this step is not built yet, so its ${esc(what)} is not here (${esc(error)}). Rebuild the slides once it exists: <code>cmake --build --preset release --target slides</code>.</div>`;
+  const notYet = /does not exist yet|not built yet|is missing$/.test(error);
+  const head = notYet ? "this step is not built yet" : "this step's output is not available";
+  return `<div class="pending">Step ${esc(step)}: ${head}, so its ${esc(what)} is not here (${esc(error)}). Rebuild the slides once it is: <code>cmake --build --preset release --target slides</code>.</div>`;
 }
 
 // Numbers as tools/report.py prints them.

@@ -217,7 +217,8 @@ function plotHtml(step, spec, opts, args) {
     .filter((r) => typeof r[xi] === "number" && typeof r[yi] === "number")
     .map((r) => ({ x: r[xi], y: r[yi], s: si >= 0 ? String(r[si]) : "" }));
   if (!pts.length) return pending(step, "plot", "no numeric points");
-  const W = Number(opts.w || 560), H = Number(opts.h || 330), L = 70, R = 16, T = 14, B = 46;
+  const W = Number(opts.w || 560), H = Number(opts.h || 330), R = 16, T = 14, B = 46;
+  const decade = (e) => (e >= -3 && e <= 6 ? (10 ** e).toLocaleString("en-US", { maximumFractionDigits: 3 }) : `1e${e}`);
   const axis = (vals, log, lo, hi) => {
     if (log) {
       const pos = vals.filter((v) => v > 0);
@@ -226,7 +227,7 @@ function plotHtml(step, spec, opts, args) {
       const from = hasZero ? a - 1 : a, to = Math.max(b, a + 1);
       const map = (v) => lo + ((v > 0 ? Math.log10(v) : from) - from) / (to - from) * (hi - lo);
       const ticks = [];
-      for (let e = from; e <= to; ++e) ticks.push({ v: hasZero && e === from ? 0 : 10 ** e, label: hasZero && e === from ? "0" : fmt(10 ** e) });
+      for (let e = from; e <= to; ++e) ticks.push({ v: hasZero && e === from ? 0 : 10 ** e, label: hasZero && e === from ? "0" : decade(e) });
       return { map, ticks };
     }
     let a = Math.min(0, ...vals), b = Math.max(...vals);
@@ -238,6 +239,8 @@ function plotHtml(step, spec, opts, args) {
     for (let v = a; v <= b + stepv / 2; v += stepv) ticks.push({ v, label: fmt(Number(v.toPrecision(6))) });
     return { map: (v) => lo + (v - a) / (b - a) * (hi - lo), ticks };
   };
+  // The left margin fits the longest y tick label and the rotated axis title.
+  const L = 34 + 7 * Math.max(...axis(pts.map((p) => p.y), !!plot.logy, 0, 1).ticks.map((t) => t.label.length));
   const ax = axis(pts.map((p) => p.x), !!plot.logx, L, W - R);
   const ay = axis(pts.map((p) => p.y), !!plot.logy, H - B, T);
   const colours = ["#0969da", "#cf222e", "#1a7f37", "#8250df", "#9a6700", "#bc4c00", "#57606a", "#e85aad"];

@@ -83,6 +83,26 @@ Vec3 offsetOrigin(const Vec3& point, const Vec3& geometricNormal, const Vec3& di
     return point + scale * n;
 }
 
+FacingNormals facingNormals(const Vec3& direction, const SurfaceHit& hit) {
+    bool entering = glm::dot(direction, hit.geometricNormal) < 0.0f;
+    Vec3 ng = entering ? hit.geometricNormal : -hit.geometricNormal;
+    Vec3 n = glm::dot(hit.shadingNormal, ng) >= 0.0f ? hit.shadingNormal : -hit.shadingNormal;
+    return {ng, n};
+}
+
+DirectLight directLight(const Material& m, const PointLight& light, const Vec3& point,
+                        const FacingNormals& normals) {
+    DirectLight d;
+    d.toLight = light.position - point;
+    float dist2 = glm::dot(d.toLight, d.toLight);
+    float cosine = glm::dot(normals.shading, d.toLight);
+    d.inRange = dist2 <= light.radius * light.radius;
+    d.facing = cosine > 0.0f && glm::dot(normals.geometric, d.toLight) > 0.0f;
+    if (d.contributes())
+        d.radiance = m.albedo * light.intensity * (cosine / (dist2 * std::sqrt(dist2)));
+    return d;
+}
+
 Renderer::Renderer(const Scene& scene, const Camera& camera, const RenderSettings& settings)
     : scene_(scene), camera_(camera), settings_(settings) {
     if (settings.width <= 0 || settings.height <= 0)
@@ -117,34 +137,28 @@ Vec3 Renderer::shade(const Ray& ray, const SurfaceHit& hit, int depth, RayCounts
     const bool force = settings_.forceAllEffects;
     // Shade the side the ray arrives from.
     bool entering = glm::dot(ray.direction, hit.geometricNormal) < 0.0f;
-    Vec3 ng = entering ? hit.geometricNormal : -hit.geometricNormal;
-    Vec3 n = glm::dot(hit.shadingNormal, ng) >= 0.0f ? hit.shadingNormal : -hit.shadingNormal;
+    FacingNormals normals = facingNormals(ray.direction, hit);
+    Vec3 ng = normals.geometric;
 
     Vec3 colour(0.0f);
     if (m.kind == Material::Kind::Diffuse) {
         colour = scene_.ambient * m.albedo;
         for (size_t i = 0; i < scene_.lights.size(); ++i) {
-            const PointLight& light = scene_.lights[i];
-            Vec3 toLight = light.position - hit.point;
-            float dist2 = glm::dot(toLight, toLight);
-            float cosine = glm::dot(n, toLight);
-            bool inRange = dist2 <= light.radius * light.radius;
-            bool facing = cosine > 0.0f && glm::dot(ng, toLight) > 0.0f;
-            if (!inRange) ++counts.lightsOutOfRange;
-            bool contributes = inRange && facing;
+            DirectLight light = directLight(m, scene_.lights[i], hit.point, normals);
+            if (!light.inRange) ++counts.lightsOutOfRange;
+            bool contributes = light.contributes();
             if (!contributes && !force) continue;
             bool shadowNeeded = needsShadowRay(int(i), hit);
             bool visible = true;
             if (shadowNeeded || force) {
                 ++counts.shadow;
-                Ray shadowRay(offsetOrigin(hit.point, hit.geometricNormal, toLight), toLight, 0.0f,
-                              1.0f - 1e-5f);
+                Ray shadowRay(offsetOrigin(hit.point, hit.geometricNormal, light.toLight),
+                              light.toLight, 0.0f, 1.0f - 1e-5f);
                 visible = !scene_.occluded(shadowRay);
             } else {
                 ++counts.shadowSkipped;
             }
-            if (contributes && visible)
-                colour += m.albedo * light.intensity * (cosine / (dist2 * std::sqrt(dist2)));
+            if (contributes && visible) colour += light.radiance;
         }
     }
     if (depth >= settings_.maxDepth) return colour;

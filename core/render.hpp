@@ -79,6 +79,26 @@ Image renderImage(const Scene& scene, const Camera& camera, const RenderSettings
 void parallelRows(int rows, int threads, const std::function<void(int row, int thread)>& body,
                   const std::string& label = "");
 
+// The normals of a hit as seen by a viewer looking along `direction`: the geometric normal
+// turned towards the viewer, the shading normal turned to the same side. Shared by the ray
+// tracer and step 06's rasterizer so both shade a point the same way.
+struct FacingNormals {
+    Vec3 geometric, shading;
+};
+FacingNormals facingNormals(const Vec3& direction, const SurfaceHit& hit);
+
+// What one point light gives a diffuse point before any shadow test:
+// albedo * intensity * cos / d^2 (cosine with the shading normal), and whether it can
+// contribute at all (in range, and in front of both normals).
+struct DirectLight {
+    Vec3 toLight{0.0f};  // unnormalized, from the point to the light
+    Vec3 radiance{0.0f};
+    bool inRange = false, facing = false;
+    bool contributes() const { return inRange && facing; }
+};
+DirectLight directLight(const Material& material, const PointLight& light, const Vec3& point,
+                        const FacingNormals& normals);
+
 // Shadow and secondary rays start slightly off the surface, on the side they leave
 // towards, so they do not hit the surface they start on (self-intersection acne).
 Vec3 offsetOrigin(const Vec3& point, const Vec3& geometricNormal, const Vec3& direction);

@@ -1,0 +1,288 @@
+#include "06_raster/measure.hpp"
+
+#include <cstdio>
+#include <filesystem>
+#include <iostream>
+
+#include "01_triangle/triangle_grid.hpp"
+#include "core/render.hpp"
+#include "core/timing.hpp"
+
+namespace boxes {
+
+namespace {
+
+Camera lookAt(Vec3 eye, Vec3 target, Vec3 up, float fov, float aspect) {
+    Camera c;
+    c.eye = eye;
+    c.view = target - eye;
+    c.up = up;
+    c.fovYDegrees = fov;
+    c.aspect = aspect;
+    return c;
+}
+
+RasterSettings rasterSettings(const MeasureSettings& m) {
+    RasterSettings s;
+    s.width = m.width;
+    s.height = m.height;
+    return s;
+}
+
+double medianMs(int repeats, const std::function<void()>& fn) {
+    return measure(repeats, fn).median * 1e3;
+}
+
+}  // namespace
+
+void attachGrid(Scene& scene) {
+    scene.geometries.clear();
+    if (scene.hasMesh())
+        scene.geometries.push_back(std::make_shared<TriangleGrid>(scene.mesh, scene.meshMaterial));
+}
+
+std::string findSharedMeshes(const std::string& dataDir) {
+    namespace fs = std::filesystem;
+    for (fs::path candidate :
+         {fs::path(dataDir) / ".." / ".." / "shared" / "data" / "meshes",
+          fs::path(dataDir) / ".." / ".." / ".." / "shared" / "data" / "meshes",
+          fs::path("..") / "shared" / "data" / "meshes"}) {
+        std::error_code ec;
+        if (fs::exists(candidate / "oa_thor.obj", ec))
+            return fs::weakly_canonical(candidate, ec).string();
+    }
+    return "";
+}
+
+std::vector<MeasureView> measureViews(const std::string& dataDir, const std::string& sharedMeshes,
+                                      float aspect) {
+    std::vector<MeasureView> views;
+    SceneOptions options{dataDir, aspect};
+    {
+        MeasureView v{"bunny (outside)", makeScene("bunny", options), {}};
+        v.camera = v.scene.camera;
+        views.push_back(std::move(v));
+    }
+    {
+        MeasureView v{"sh1 (outside)", makeScene("sh1", options), {}};
+        v.camera = v.scene.camera;
+        views.push_back(std::move(v));
+    }
+    if (!sharedMeshes.empty()) {
+        MeasureView v{"oa_thor (inside)", makeScene(sharedMeshes + "/oa_thor.obj", options), {}};
+        v.camera = lookAt(Vec3(960, -384, 2), Vec3(960, 600, 2), Vec3(0, 0, 1), 90.0f, aspect);
+        views.push_back(std::move(v));
+    }
+    for (MeasureView& v : views) attachGrid(v.scene);
+    return views;
+}
+
+Table measureVisibility(const std::vector<MeasureView>& views, const MeasureSettings& m) {
+    Table t;
+    t.id = "visibility";
+    t.title = "Primary visibility: the rasterizer against the ray tracer, pixel for pixel";
+    t.columns = {"view",
+                 "triangles",
+                 "covered raster",
+                 "covered traced",
+                 "same triangle %",
+                 "differ on edges",
+                 "differ elsewhere",
+                 "coverage diff % of image",
+                 "max depth error"};
+    t.note = std::to_string(m.width) + "x" + std::to_string(m.height) +
+             "; same triangle: share of pixels covered by either where both name the same mesh "
+             "triangle; 'on edges': the other's triangle is seen within one pixel; depth error "
+             "relative, where they agree";
+    for (const MeasureView& v : views) {
+        std::cerr << "06_raster: visibility on " << v.name << "...\n";
+        RasterScene raster = RasterScene::fromScene(v.scene);
+        FrameBuffers buffers;
+        rasterizeFrame(raster, v.camera, rasterSettings(m), buffers);
+        TracedFrame traced = traceFrame(v.scene, v.camera, m.width, m.height, false, 0);
+        VisibilityComparison c =
+            compareVisibility(m.width, m.height, meshIds(raster, buffers),
+                              meshDepths(raster, buffers), traced.ids, traced.depth);
+        t.row({v.name, (long long)raster.meshTriangles, (long long)c.coveredRaster,
+               (long long)c.coveredTraced, 100.0 * c.agreement(), (long long)c.differOnEdge,
+               (long long)c.differElsewhere, 100.0 * c.coverageDifference(), c.maxDepthError});
+    }
+    return t;
+}
+
+Table measureFrameTimes(const std::vector<MeasureView>& views, const MeasureSettings& m) {
+    Table t;
+    t.id = "frame_time";
+    t.title = "Time per frame, single thread: rasterizer against ray tracer (ms, median)";
+    t.columns = {"view",
+                 "triangles",
+                 "raster visibility",
+                 "raster shaded",
+                 "raster + shadow map",
+                 "raster + shadow rays",
+                 "traced visibility",
+                 "traced shaded (Whitted)",
+                 "visibility speed-up"};
+    t.note = std::to_string(m.width) + "x" + std::to_string(m.height) + ", median of " +
+             std::to_string(m.repeats) +
+             " frames; raster shaded: deferred shading of the z-buffer without shadows; the shadow "
+             "map is rebuilt every frame (2048^2); the ray tracer uses step 01's uniform grid";
+    for (const MeasureView& v : views) {
+        std::cerr << "06_raster: timing frames on " << v.name << "...\n";
+        RasterScene raster = RasterScene::fromScene(v.scene);
+        RasterSettings rs = rasterSettings(m);
+        FrameBuffers buffers;
+        double rasterMs =
+            medianMs(m.repeats, [&] { rasterizeFrame(raster, v.camera, rs, buffers); });
+        auto shaded = [&](ShadowMode mode) {
+            ShadeSettings ss;
+            ss.shadows = mode;
+            return medianMs(m.repeats, [&] {
+                rasterizeFrame(raster, v.camera, rs, buffers);
+                keepValue(shadeFrame(v.scene, raster, v.camera, buffers, ss).image.pixels()[0].x);
+            });
+        };
+        double none = shaded(ShadowMode::None), map = shaded(ShadowMode::Map),
+               rays = shaded(ShadowMode::Rays);
+        double traced = medianMs(
+            m.repeats, [&] { traceFrame(v.scene, v.camera, m.width, m.height, false, 1); });
+        RenderSettings settings;
+        settings.width = m.width;
+        settings.height = m.height;
+        settings.threads = 1;
+        double whitted = medianMs(
+            m.repeats, [&] { keepValue(renderImage(v.scene, v.camera, settings).pixels()[0].x); });
+        t.row({v.name, (long long)raster.meshTriangles, rasterMs, none, map, rays, traced, whitted,
+               traced / std::max(rasterMs, 1e-9)});
+    }
+    return t;
+}
+
+Table measureShadowBias(const MeasureView& v, const MeasureSettings& m) {
+    Table t;
+    t.id = "shadow_bias";
+    t.title = "Shadow map depth bias against the ray tracer's shadows: acne and peter-panning";
+    t.columns = {"bias (x diagonal)", "acne pixels", "peter-panning pixels", "disagree %",
+                 "map size"};
+    t.note = v.name +
+             ", first light; acne: the map shadows a point the ray tracer lights; "
+             "peter-panning: the map lights a point the ray tracer shadows; over pixels where both "
+             "see the same triangle and the light can reach";
+    RasterScene raster = RasterScene::fromScene(v.scene);
+    FrameBuffers buffers;
+    rasterizeFrame(raster, v.camera, rasterSettings(m), buffers);
+    TracedFrame traced = traceFrame(v.scene, v.camera, m.width, m.height, true, 0);
+    std::vector<uint32_t> ids = meshIds(raster, buffers);
+    for (int size : {1024, 4096}) {
+        std::vector<ShadowMap> maps;
+        for (const PointLight& light : v.scene.lights)
+            maps.push_back(buildShadowMap(raster, light, size));
+        for (double relative : {0.0, 1e-4, 3e-4, 1e-3, 3e-3, 1e-2, 3e-2}) {
+            ShadeSettings ss;
+            ss.shadows = ShadowMode::Map;
+            ss.mapBias = relative > 0.0 ? relative * double(raster.diagonal()) : 1e-30;
+            ShadedFrame f = shadeFrame(v.scene, raster, v.camera, buffers, ss, &maps);
+            ShadowComparison c =
+                compareShadows(ids, f.litByFirstLight, traced.ids, traced.litByFirstLight);
+            t.row({relative, (long long)c.acne, (long long)c.leaks, 100.0 * c.disagreement(),
+                   (long long)size});
+        }
+    }
+    return t;
+}
+
+Table measureShadowMethods(const MeasureView& v, const MeasureSettings& m) {
+    Table t;
+    t.id = "shadows";
+    t.title = "Shadows two ways against the ray tracer's shadow rays";
+    t.columns = {"method", "pixels compared", "disagree", "disagree %", "ms per frame"};
+    t.note = v.name + ", first light, single thread, median of " + std::to_string(m.repeats) +
+             "; the frame time includes rasterizing and shading (and building the map)";
+    RasterScene raster = RasterScene::fromScene(v.scene);
+    RasterSettings rs = rasterSettings(m);
+    FrameBuffers buffers;
+    TracedFrame traced = traceFrame(v.scene, v.camera, m.width, m.height, true, 1);
+    for (ShadowMode mode : {ShadowMode::Map, ShadowMode::Rays}) {
+        ShadeSettings ss;
+        ss.shadows = mode;
+        ShadedFrame f;
+        double ms = medianMs(m.repeats, [&] {
+            rasterizeFrame(raster, v.camera, rs, buffers);
+            f = shadeFrame(v.scene, raster, v.camera, buffers, ss);
+        });
+        ShadowComparison c = compareShadows(meshIds(raster, buffers), f.litByFirstLight, traced.ids,
+                                            traced.litByFirstLight);
+        t.row({std::string(shadowModeName(mode)), (long long)c.compared,
+               (long long)(c.acne + c.leaks), 100.0 * c.disagreement(), ms});
+    }
+    t.row(
+        {std::string("ray tracer (visibility + shadow rays)"), 0LL, 0LL, 0.0, traced.milliseconds});
+    return t;
+}
+
+Table measureInterpolation(const MeasureView& bunny, const MeasureSettings& m,
+                           const std::string& pngStem,
+                           std::vector<std::pair<std::string, std::string>>& images) {
+    Table t;
+    t.id = "interpolation";
+    t.title =
+        "Affine against perspective-correct interpolation: position error against the ray tracer";
+    t.columns = {"view", "weights", "mean error (x diagonal)", "max error (x diagonal)"};
+    t.note =
+        "the interpolated surface point against the ray tracer's hit point, over pixels where "
+        "both see the same triangle";
+    // A floor of two triangles seen at a grazing angle: large triangles, strong perspective.
+    MeasureView floor{"floor quad (grazing)", Scene{}, {}};
+    floor.scene.name = "floor";
+    floor.scene.mesh.positions = {{-10, 0, -10}, {10, 0, -10}, {10, 0, 10}, {-10, 0, 10}};
+    floor.scene.mesh.triangles = {{0, 2, 1}, {0, 3, 2}};
+    floor.scene.mesh.computeVertexNormals();
+    floor.scene.lights.push_back({Vec3(0, 6, 0), Vec3(60.0f), kInfinity<float>});
+    floor.camera = lookAt(Vec3(0, 1.0f, 9.5f), Vec3(0, 0, 0), Vec3(0, 1, 0), 60.0f,
+                          float(m.width) / float(m.height));
+    attachGrid(floor.scene);
+    for (const MeasureView* v : {static_cast<const MeasureView*>(&floor), &bunny}) {
+        RasterScene raster = RasterScene::fromScene(v->scene);
+        TracedFrame traced = traceFrame(v->scene, v->camera, m.width, m.height, false, 0);
+        CameraBasisT<float> basis = v->camera.basis();
+        for (bool correct : {false, true}) {
+            RasterSettings rs = rasterSettings(m);
+            rs.perspectiveCorrect = correct;
+            FrameBuffers buffers;
+            rasterizeFrame(raster, v->camera, rs, buffers);
+            double sum = 0.0, worst = 0.0;
+            size_t n = 0;
+            for (int y = 0; y < m.height; ++y)
+                for (int x = 0; x < m.width; ++x) {
+                    size_t i = buffers.index(x, y);
+                    SurfaceHit hit;
+                    if (traced.ids[i] == kNoPrimitive || buffers.triangle[i] != traced.ids[i])
+                        continue;
+                    if (!surfaceAt(raster, buffers, x, y, hit)) continue;
+                    Vec3 d = v->camera.directionThrough(basis, float(x) + 0.5f, float(y) + 0.5f,
+                                                        m.width, m.height);
+                    Vec3 exact = v->camera.eye + d * (traced.depth[i] / glm::dot(d, basis.forward));
+                    double e = glm::length(glm::dvec3(hit.point) - glm::dvec3(exact)) /
+                               double(raster.diagonal());
+                    sum += e;
+                    worst = std::max(worst, e);
+                    ++n;
+                }
+            t.row({v->name, std::string(correct ? "perspective-correct" : "affine"),
+                   n ? sum / double(n) : 0.0, worst});
+            if (v == &floor && !pngStem.empty()) {
+                ShadeSettings ss;
+                ss.shadows = ShadowMode::None;
+                ss.checker = true;
+                std::string path = pngStem + (correct ? "-perspective.png" : "-affine.png");
+                shadeFrame(v->scene, raster, v->camera, buffers, ss).image.writePng(path);
+                images.push_back(
+                    {path, correct ? "a checker on the floor, perspective-correct weights"
+                                   : "the same floor with affine weights: the checker warps"});
+            }
+        }
+    }
+    return t;
+}
+
+}  // namespace boxes

@@ -1,0 +1,381 @@
+#include "06_raster/pipeline.hpp"
+
+#include <string>
+
+#include "core/bounds.hpp"
+#include "core/exercise.hpp"
+#include "core/mesh.hpp"
+#include "core/render.hpp"
+#include "core/timing.hpp"
+
+namespace boxes {
+
+namespace {
+
+// How far a plane's quad reaches, in scene diagonals: far past anything a view shows.
+constexpr float kPlaneReach = 1000.0f;
+
+void addTriangle(RasterScene& s, uint32_t a, uint32_t b, uint32_t c, int material, int object) {
+    s.triangles.push_back({a, b, c});
+    s.material.push_back(material);
+    s.object.push_back(object);
+}
+
+}  // namespace
+
+RasterScene RasterScene::fromScene(const Scene& scene, int sphereSegments) {
+    RasterScene s;
+    const Mesh& mesh = scene.mesh;
+    for (size_t i = 0; i < mesh.positions.size(); ++i)
+        if (!isFinite(mesh.positions[i]))
+            throw InputError("mesh '" + scene.name + "': vertex " + std::to_string(i + 1) +
+                             " has a coordinate that is not a finite number");
+    Bounds3f bounds;
+    const int meshObject = int(scene.spheres.size() + scene.planes.size());
+    s.positions = mesh.positions;
+    s.normals = mesh.normals;
+    if (s.normals.size() != s.positions.size()) s.normals.assign(s.positions.size(), Vec3(0.0f));
+    for (const auto& t : mesh.triangles)
+        addTriangle(s, t[0], t[1], t[2], scene.meshMaterial, meshObject);
+    s.meshTriangles = mesh.triangles.size();
+    for (const Vec3& p : mesh.positions) bounds.extend(p);
+
+    // Spheres: a latitude-longitude tessellation, vertex normals from the centre.
+    const int rings = std::max(2, sphereSegments / 2), segments = std::max(3, sphereSegments);
+    for (size_t k = 0; k < scene.spheres.size(); ++k) {
+        const Sphere& sphere = scene.spheres[k].shape;
+        uint32_t base = uint32_t(s.positions.size());
+        for (int r = 0; r <= rings; ++r) {
+            float theta = kPi * float(r) / float(rings);
+            for (int g = 0; g <= segments; ++g) {
+                float phi = 2.0f * kPi * float(g) / float(segments);
+                Vec3 n(std::sin(theta) * std::cos(phi), std::cos(theta),
+                       -std::sin(theta) * std::sin(phi));
+                s.positions.push_back(sphere.centre + sphere.radius * n);
+                s.normals.push_back(n);
+            }
+        }
+        for (int r = 0; r < rings; ++r)
+            for (int g = 0; g < segments; ++g) {
+                uint32_t a = base + uint32_t(r * (segments + 1) + g), b = a + 1;
+                uint32_t c = a + uint32_t(segments + 1), d = c + 1;
+                // Outward winding: (b - a) x (c - a) points away from the centre.
+                if (r > 0) addTriangle(s, a, c, b, scene.spheres[k].material, int(k));
+                if (r < rings - 1) addTriangle(s, b, c, d, scene.spheres[k].material, int(k));
+            }
+        bounds.extend(sphere.centre - Vec3(sphere.radius));
+        bounds.extend(sphere.centre + Vec3(sphere.radius));
+    }
+    if (bounds.isEmpty()) bounds = Bounds3f(Vec3(-1.0f), Vec3(1.0f));
+    s.boundsMin = bounds.min;
+    s.boundsMax = bounds.max;
+
+    // Planes: a quad around the point of the plane nearest the scene's centre.
+    float reach = kPlaneReach * std::max(s.diagonal(), 1e-3f);
+    for (size_t k = 0; k < scene.planes.size(); ++k) {
+        const Plane& plane = scene.planes[k].shape;
+        Vec3 n = glm::normalize(plane.normal);
+        Vec3 c = bounds.centroid();
+        c -= (glm::dot(plane.normal, c) + plane.d) / glm::dot(plane.normal, plane.normal) *
+             plane.normal;
+        Vec3 helper = std::abs(n.x) < 0.9f ? Vec3(1, 0, 0) : Vec3(0, 0, 1);
+        Vec3 t = glm::normalize(glm::cross(n, helper)), b = glm::cross(n, t);
+        uint32_t base = uint32_t(s.positions.size());
+        for (Vec3 corner : {c - reach * t - reach * b, c + reach * t - reach * b,
+                            c + reach * t + reach * b, c - reach * t + reach * b}) {
+            s.positions.push_back(corner);
+            s.normals.push_back(n);
+        }
+        int object = int(scene.spheres.size() + k);
+        // Counter-clockwise seen from the side the normal points to.
+        addTriangle(s, base, base + 3, base + 1, scene.planes[k].material, object);
+        addTriangle(s, base + 1, base + 3, base + 2, scene.planes[k].material, object);
+        s.hasPlanes = true;
+    }
+    return s;
+}
+
+std::pair<double, double> nearFarFor(const RasterScene& scene, const Camera& camera,
+                                     const RasterSettings& settings) {
+    const double diagonal = std::max(double(scene.diagonal()), 1e-6);
+    double near = settings.near, far = settings.far;
+    if (settings.near != 0.0 && !(settings.near > 0.0 && std::isfinite(settings.near)))
+        throw InputError("--near must be a positive distance");
+    if (settings.far != 0.0 && !(settings.far > 0.0 && std::isfinite(settings.far)))
+        throw InputError("--far must be a positive distance");
+    if (near == 0.0) near = 1e-5 * diagonal;
+    if (far == 0.0) {
+        CameraBasisT<float> b = camera.basis();
+        double deepest = 0.0;
+        for (int i = 0; i < 8; ++i) {
+            Vec3 corner((i & 1) ? scene.boundsMax.x : scene.boundsMin.x,
+                        (i & 2) ? scene.boundsMax.y : scene.boundsMin.y,
+                        (i & 4) ? scene.boundsMax.z : scene.boundsMin.z);
+            deepest =
+                std::max(deepest, glm::dot(glm::dvec3(corner - camera.eye), glm::dvec3(b.forward)));
+        }
+        if (scene.hasPlanes)
+            deepest = std::max(
+                deepest, 1.5 * double(kPlaneReach) * diagonal +
+                             glm::length(glm::dvec3(camera.eye) -
+                                         glm::dvec3(0.5f * (scene.boundsMin + scene.boundsMax))));
+        far = std::max(deepest * (1.0 + 1e-3) + near, 2.0 * near);
+    }
+    if (!(far > near))
+        throw InputError("--far must be greater than --near (near " + std::to_string(near) + ")");
+    return {near, far};
+}
+
+void FrameBuffers::reset(int w, int h) {
+    if (w <= 0 || h <= 0) throw InputError("image size must be positive");
+    width = w;
+    height = h;
+    size_t n = size_t(w) * size_t(h);
+    triangle.assign(n, kNoPrimitive);
+    depth.assign(n, kInfinity<float>);
+    weight1.assign(n, 0.0f);
+    weight2.assign(n, 0.0f);
+}
+
+FrameStats rasterizeFrame(const RasterScene& scene, const Camera& camera,
+                          const RasterSettings& settings, FrameBuffers& buffers, size_t first,
+                          size_t last) {
+    Stopwatch watch;
+    FrameStats stats;
+    auto [near, far] = nearFarFor(scene, camera, settings);
+    const Mat4d viewProjection = projectionMatrix(camera, near, far) * viewMatrix(camera);
+    buffers.reset(settings.width, settings.height);
+    const int width = settings.width, height = settings.height;
+    std::array<Vec4d, 6> planes{kNearPlane, kFarPlane};
+    auto band = guardBandPlanes(settings.guardBand);
+    std::copy(band.begin(), band.end(), planes.begin() + 2);
+    if (last == 0 || last > scene.triangles.size()) last = scene.triangles.size();
+
+    for (size_t t = first; t < last; ++t) {
+        ++stats.trianglesIn;
+        const auto& tri = scene.triangles[t];
+        ClipPolygon polygon;
+        for (int k = 0; k < 3; ++k) {
+            glm::dvec3 weights(0.0);
+            weights[k] = 1.0;
+            polygon.add({viewProjection * Vec4d(glm::dvec3(scene.positions[tri[size_t(k)]]), 1.0),
+                         weights});
+        }
+        // Trivially outside one plane: nothing to draw. Inside every plane: no clipping.
+        bool outside = false, inside = true;
+        for (const Vec4d& plane : planes) {
+            int in = 0;
+            for (int k = 0; k < 3; ++k)
+                in += glm::dot(plane, polygon.vertices[size_t(k)].position) >= 0.0;
+            outside = outside || in == 0;
+            inside = inside && in == 3;
+        }
+        if (outside) {
+            ++stats.culledOutside;
+            continue;
+        }
+        if (!inside) {
+            ++stats.clipped;
+            for (const Vec4d& plane : planes) {
+                polygon = clipAgainstPlane(polygon, plane);
+                if (polygon.count < 3) break;
+            }
+            if (polygon.count < 3) {
+                ++stats.culledOutside;
+                continue;
+            }
+        }
+        // The convex polygon as a fan; every piece keeps the triangle's winding.
+        bool drawn = false;
+        for (int k = 1; k + 1 < polygon.count; ++k) {
+            const ClipVertex* v[3] = {&polygon.vertices[0], &polygon.vertices[size_t(k)],
+                                      &polygon.vertices[size_t(k + 1)]};
+            FixedPoint2 s[3];
+            glm::dvec3 w;
+            for (int i = 0; i < 3; ++i) {
+                glm::dvec3 p = clipToScreen(v[i]->position, width, height);
+                s[i] = snapToSubpixel(p.x, p.y);
+                w[i] = v[i]->position.w;
+            }
+            const glm::dvec3 inverseW = 1.0 / w;
+            int64_t area = rasterizeTriangle(
+                s[0], s[1], s[2], width, height, settings.backfaceCulling,
+                [&](int x, int y, const glm::dvec3& screen) {
+                    ++stats.fragments;
+                    double depth = 1.0 / glm::dot(screen, inverseW);
+                    size_t i = buffers.index(x, y);
+                    if (!depthTest(buffers.depth[i], float(depth))) return;
+                    glm::dvec3 l =
+                        settings.perspectiveCorrect ? perspectiveCorrectWeights(screen, w) : screen;
+                    glm::dvec3 original =
+                        l.x * v[0]->weights + l.y * v[1]->weights + l.z * v[2]->weights;
+                    buffers.triangle[i] = uint32_t(t);
+                    buffers.weight1[i] = float(original.y);
+                    buffers.weight2[i] = float(original.z);
+                });
+            drawn = drawn || area > 0 || (area < 0 && !settings.backfaceCulling);
+        }
+        if (drawn)
+            ++stats.trianglesDrawn;
+        else
+            ++stats.culledBackface;
+    }
+    for (uint32_t id : buffers.triangle) stats.pixelsCovered += id != kNoPrimitive;
+    stats.milliseconds = watch.milliseconds();
+    return stats;
+}
+
+ShadowMap buildShadowMap(const RasterScene& scene, const PointLight& light, int size) {
+    ShadowMap map;
+    map.size = size;
+    Vec3 centre = 0.5f * (scene.boundsMin + scene.boundsMax);
+    float radius = 0.5f * scene.diagonal();
+    Camera& c = map.lightCamera;
+    c.eye = light.position;
+    c.view = centre - light.position;
+    if (isZero(c.view)) c.view = Vec3(0, -1, 0);
+    c.up = Vec3(0, 1, 0);
+    float distance = glm::length(centre - light.position);
+    float halfAngle =
+        distance > radius * 1.01f ? std::asin(radius / distance) * 1.05f : glm::radians(85.0f);
+    c.fovYDegrees = std::min(170.0f, glm::degrees(2.0f * halfAngle));
+    c.aspect = 1.0f;
+    RasterSettings settings;
+    settings.width = settings.height = size;
+    FrameBuffers buffers;
+    rasterizeFrame(scene, c, settings, buffers);
+    auto [near, far] = nearFarFor(scene, c, settings);
+    map.viewProjection = projectionMatrix(c, near, far) * viewMatrix(c);
+    map.depth = std::move(buffers.depth);
+    return map;
+}
+
+// EXERCISE 6.8: shadow map lookup with a depth bias (2 points)
+bool litByShadowMap(const ShadowMap& map, const Vec3& point, double bias) {
+    // BEGIN SOLUTION
+    Vec4d clip = map.viewProjection * Vec4d(glm::dvec3(point), 1.0);
+    if (!(clip.w > 0.0)) return true;  // behind the light's view
+    // The map's texel: divide by w, then the viewport (row 0 at the top).
+    double x = (clip.x / clip.w + 1.0) * 0.5 * map.size,
+           y = (1.0 - clip.y / clip.w) * 0.5 * map.size;
+    if (!(x >= 0.0 && x < map.size && y >= 0.0 && y < map.size)) return true;
+    size_t texel = size_t(y) * size_t(map.size) + size_t(x);
+    return clip.w - bias <= double(map.depth[texel]);
+    // END SOLUTION
+}
+
+// EXERCISE 6.9: the hybrid: a shadow ray from the rasterized position through the scene (1 point)
+bool litByShadowRay(const Scene& scene, const Vec3& point, const Vec3& geometricNormal,
+                    const PointLight& light) {
+    // BEGIN SOLUTION
+    Vec3 toLight = light.position - point;
+    Ray ray(offsetOrigin(point, geometricNormal, toLight), toLight, 0.0f, 1.0f - 1e-5f);
+    return !scene.occluded(ray);
+    // END SOLUTION
+}
+
+const char* shadowModeName(ShadowMode mode) {
+    switch (mode) {
+        case ShadowMode::None:
+            return "none";
+        case ShadowMode::Map:
+            return "shadow map";
+        case ShadowMode::Rays:
+            return "shadow rays (hybrid)";
+    }
+    return "?";
+}
+
+bool surfaceAt(const RasterScene& scene, const FrameBuffers& buffers, int x, int y,
+               SurfaceHit& hit) {
+    size_t i = buffers.index(x, y);
+    uint32_t id = buffers.triangle[i];
+    if (id == kNoPrimitive) return false;
+    const auto& tri = scene.triangles[id];
+    float w1 = buffers.weight1[i], w2 = buffers.weight2[i], w0 = 1.0f - w1 - w2;
+    Vec3 a = scene.positions[tri[0]], b = scene.positions[tri[1]], c = scene.positions[tri[2]];
+    hit.point = w0 * a + w1 * b + w2 * c;
+    Vec3 n = glm::cross(b - a, c - a);
+    float length = glm::length(n);
+    hit.geometricNormal = length > 0.0f ? n / length : Vec3(0, 1, 0);
+    Vec3 s = w0 * scene.normals[tri[0]] + w1 * scene.normals[tri[1]] + w2 * scene.normals[tri[2]];
+    float sLength = glm::length(s);
+    hit.shadingNormal = sLength > 0.0f ? s / sLength : hit.geometricNormal;
+    hit.u = w1;
+    hit.v = w2;
+    hit.t = buffers.depth[i];
+    hit.material = scene.material[id];
+    hit.object = scene.object[id];
+    hit.primitive = id;
+    hit.kind = SurfaceHit::Kind::Triangle;
+    return true;
+}
+
+ShadedFrame shadeFrame(const Scene& scene, const RasterScene& raster, const Camera& camera,
+                       const FrameBuffers& buffers, const ShadeSettings& settings,
+                       const std::vector<ShadowMap>* maps) {
+    Stopwatch watch;
+    ShadedFrame frame;
+    std::vector<ShadowMap> ownMaps;
+    if (settings.shadows == ShadowMode::Map && !maps) {
+        for (const PointLight& light : scene.lights)
+            ownMaps.push_back(buildShadowMap(raster, light, settings.mapSize));
+        maps = &ownMaps;
+    }
+    const double bias =
+        settings.mapBias > 0.0 ? settings.mapBias : 2e-3 * double(raster.diagonal());
+    const int width = buffers.width, height = buffers.height;
+    frame.image = Image(width, height, scene.background);
+    frame.litByFirstLight.assign(size_t(width) * size_t(height), -1);
+    const CameraBasisT<float> basis = camera.basis();
+    const float checkerSize = std::max(raster.diagonal(), 1e-6f) / 24.0f;
+    for (int y = 0; y < height; ++y)
+        for (int x = 0; x < width; ++x) {
+            SurfaceHit hit;
+            if (!surfaceAt(raster, buffers, x, y, hit)) continue;
+            const Vec3 direction =
+                camera.directionThrough(basis, float(x) + 0.5f, float(y) + 0.5f, width, height);
+            FacingNormals normals = facingNormals(direction, hit);
+            // Every material shaded as diffuse: mirrors and glass need rays (global data).
+            Material m = Material::diffuse(scene.materials[size_t(hit.material)].albedo);
+            if (settings.checker) {
+                glm::ivec3 cell = glm::ivec3(glm::floor(hit.point / checkerSize));
+                if ((cell.x + cell.y + cell.z) & 1) m.albedo *= 0.3f;
+            }
+            Vec3 colour = scene.ambient * m.albedo;
+            for (size_t l = 0; l < scene.lights.size(); ++l) {
+                const PointLight& light = scene.lights[l];
+                DirectLight d = directLight(m, light, hit.point, normals);
+                if (!d.contributes()) continue;
+                bool lit = true;
+                if (settings.shadows == ShadowMode::Map)
+                    lit = litByShadowMap((*maps)[l], hit.point, bias);
+                else if (settings.shadows == ShadowMode::Rays) {
+                    ++frame.shadowRays;
+                    lit = litByShadowRay(scene, hit.point, hit.geometricNormal, light);
+                }
+                if (l == 0) frame.litByFirstLight[buffers.index(x, y)] = lit ? 1 : 0;
+                if (lit) colour += d.radiance;
+            }
+            frame.image.at(x, y) = colour;
+        }
+    frame.milliseconds = watch.milliseconds();
+    return frame;
+}
+
+std::vector<uint32_t> meshIds(const RasterScene& scene, const FrameBuffers& buffers) {
+    std::vector<uint32_t> ids(buffers.triangle);
+    for (uint32_t& id : ids)
+        if (id != kNoPrimitive && id >= scene.meshTriangles) id = kNoPrimitive;
+    return ids;
+}
+
+std::vector<float> meshDepths(const RasterScene& scene, const FrameBuffers& buffers) {
+    std::vector<float> depth(buffers.depth);
+    for (size_t i = 0; i < depth.size(); ++i)
+        if (buffers.triangle[i] == kNoPrimitive || buffers.triangle[i] >= scene.meshTriangles)
+            depth[i] = kInfinity<float>;
+    return depth;
+}
+
+}  // namespace boxes

@@ -1,0 +1,148 @@
+// Step 06: the rasterizer's building blocks, the exercises. A point goes from world space
+// through the camera's view space and clip space to the screen; triangles are clipped in
+// homogeneous clip space, covered pixels found with edge functions and a top-left fill
+// rule, hidden surfaces removed by a z-buffer, and attributes interpolated with 1/w.
+#pragma once
+
+#include <array>
+#include <cstdint>
+#include <glm/mat4x4.hpp>
+
+#include "core/camera.hpp"
+
+namespace boxes {
+
+using Vec4d = glm::dvec4;
+using Mat4d = glm::dmat4;
+
+// Exercise 6.1: the view matrix (world -> camera space, glm::lookAt: right-handed, the
+// camera looks down -z) and the projection (camera -> clip space, glm::perspective with
+// GLM's default clip depth: the near plane maps to z/w = -1, the far plane to +1). Built
+// from the core's one camera model (eye, view direction, up, vertical field of view,
+// aspect ratio), so pixel centres match the ray tracer's primary rays.
+Mat4d viewMatrix(const Camera& camera);
+Mat4d projectionMatrix(const Camera& camera, double near, double far);
+
+// Exercise 6.2: clip space -> screen: divide by w (normalized device coordinates in
+// [-1, 1]), then the viewport: x from [-1, 1] to [0, width], y flipped so that row 0 is
+// the top, [1, -1] to [0, height]; z stays the NDC depth. Pixel (x, y) has its centre at
+// (x + 0.5, y + 0.5), as in Camera::directionThrough.
+glm::dvec3 clipToScreen(const Vec4d& clip, int width, int height);
+
+// A vertex of a clipped polygon: its clip-space position and its weights with respect to
+// the original triangle's three vertices (so any attribute can be interpolated later).
+struct ClipVertex {
+    Vec4d position{0.0};
+    glm::dvec3 weights{0.0};
+};
+
+// A convex polygon during clipping: a triangle, clipped by up to six planes, has at most
+// 3 + 6 vertices.
+struct ClipPolygon {
+    std::array<ClipVertex, 12> vertices;
+    int count = 0;
+    void add(const ClipVertex& v) { vertices[size_t(count++)] = v; }
+};
+
+// A plane in homogeneous clip space: a point p is inside when dot(plane, p) >= 0.
+// The near plane with GLM's default depth is z + w >= 0; the far plane is w - z >= 0.
+constexpr Vec4d kNearPlane{0.0, 0.0, 1.0, 1.0};
+constexpr Vec4d kFarPlane{0.0, 0.0, -1.0, 1.0};
+// The guard band: |x| <= g w and |y| <= g w, so screen coordinates stay within g times the
+// image and fit the fixed-point edge functions; triangles inside the band are not clipped.
+inline std::array<Vec4d, 4> guardBandPlanes(double g) {
+    return {Vec4d(-1, 0, 0, g), Vec4d(1, 0, 0, g), Vec4d(0, -1, 0, g), Vec4d(0, 1, 0, g)};
+}
+
+// Exercise 6.3: one Sutherland-Hodgman step (Sutherland, Hodgman 1974): the part of the
+// convex polygon on the inside of `plane`. A new vertex is placed where an edge crosses
+// the plane, interpolated linearly in clip space (weights too); computed from the inside
+// end towards the outside end so that two triangles sharing the edge get the same point.
+ClipPolygon clipAgainstPlane(const ClipPolygon& polygon, const Vec4d& plane);
+
+// Screen positions in fixed point, 1/256 pixel: edge functions on integers are exact, so
+// two triangles sharing an edge see exactly opposite values (no gap, no double draw).
+constexpr int kSubpixelBits = 8;
+constexpr int64_t kSubpixelOne = int64_t(1) << kSubpixelBits;
+struct FixedPoint2 {
+    int64_t x = 0, y = 0;
+};
+inline FixedPoint2 snapToSubpixel(double x, double y) {
+    return {int64_t(std::llround(x * double(kSubpixelOne))),
+            int64_t(std::llround(y * double(kSubpixelOne)))};
+}
+// The centre of pixel (x, y) in fixed point.
+inline FixedPoint2 pixelCentre(int x, int y) {
+    return {int64_t(x) * kSubpixelOne + kSubpixelOne / 2,
+            int64_t(y) * kSubpixelOne + kSubpixelOne / 2};
+}
+
+// Exercise 6.4: the edge function E(a, b, p) = (b - a) x (p - a) (the z of the 2D cross
+// product, screen y pointing down): zero on the line through a and b, its sign tells the
+// side, and E(v0, v1, v2) is twice the triangle's signed area. Exact on fixed point.
+int64_t edgeFunction(const FixedPoint2& a, const FixedPoint2& b, const FixedPoint2& p);
+
+// Exercise 6.5: the top-left fill rule (as in Direct3D and OpenGL): a pixel centre exactly
+// on an edge belongs to the triangle only when the edge is a top edge (horizontal, the
+// triangle below it) or a left edge. For a triangle with positive area E(v0, v1, v2) > 0
+// (clockwise on a screen with y down), the edge a -> b is a top edge when it is horizontal
+// and runs to +x, a left edge when it runs up (to -y).
+bool isTopLeftEdge(const FixedPoint2& a, const FixedPoint2& b);
+
+// Exercise 6.6: the z-buffer test: draw when the incoming depth is nearer than the stored
+// one (and store it). On a tie the triangle drawn first keeps the pixel, so the result
+// does not flicker and matches the ray tracer's "first hit found wins".
+bool depthTest(float& stored, float incoming);
+
+// Exercise 6.7: perspective-correct interpolation weights. `screen` are the barycentric
+// weights of the pixel centre in screen space (affine, from the edge functions), `w` the
+// clip w of the three vertices (their depth along the view). An attribute that is linear
+// on the triangle in 3D is linear in screen space only after dividing by w: weight_i =
+// (screen_i / w_i) / sum_j (screen_j / w_j) (Heckbert, Moreton 1991).
+glm::dvec3 perspectiveCorrectWeights(const glm::dvec3& screen, const glm::dvec3& w);
+
+// The pixels a triangle covers: calls covered(x, y, screenWeights) for every pixel centre
+// inside the triangle under the top-left rule, within [0, width) x [0, height). The
+// vertices may come in either winding; zero area draws nothing. Returns the signed area
+// (twice, in fixed point) so callers can cull back faces before drawing.
+template <typename Covered>
+int64_t rasterizeTriangle(FixedPoint2 v0, FixedPoint2 v1, FixedPoint2 v2, int width, int height,
+                          bool cullNegative, Covered&& covered) {
+    int64_t area = edgeFunction(v0, v1, v2);
+    if (area == 0 || (cullNegative && area < 0)) return area;
+    // Work on the positive winding; remember to swap the weights of vertices 1 and 2 back.
+    bool swapped = area < 0;
+    if (swapped) std::swap(v1, v2);
+    int64_t positive = swapped ? -area : area;
+    // Edge i is opposite vertex i; a non-top-left edge needs E > 0, i.e. E - 1 >= 0.
+    const int64_t bias0 = isTopLeftEdge(v1, v2) ? 0 : -1;
+    const int64_t bias1 = isTopLeftEdge(v2, v0) ? 0 : -1;
+    const int64_t bias2 = isTopLeftEdge(v0, v1) ? 0 : -1;
+    auto pixelMin = [](int64_t a, int64_t b, int64_t c) {
+        int64_t m = std::min(a, std::min(b, c));
+        return (m - kSubpixelOne / 2 + kSubpixelOne - 1) >> kSubpixelBits;  // ceil((m - 1/2))
+    };
+    auto pixelMax = [](int64_t a, int64_t b, int64_t c) {
+        int64_t m = std::max(a, std::max(b, c));
+        return (m - kSubpixelOne / 2) >> kSubpixelBits;  // floor(m - 1/2)
+    };
+    int64_t x0 = std::max<int64_t>(0, pixelMin(v0.x, v1.x, v2.x));
+    int64_t y0 = std::max<int64_t>(0, pixelMin(v0.y, v1.y, v2.y));
+    int64_t x1 = std::min<int64_t>(width - 1, pixelMax(v0.x, v1.x, v2.x));
+    int64_t y1 = std::min<int64_t>(height - 1, pixelMax(v0.y, v1.y, v2.y));
+    const double inverseArea = 1.0 / double(positive);
+    for (int64_t y = y0; y <= y1; ++y)
+        for (int64_t x = x0; x <= x1; ++x) {
+            FixedPoint2 p = pixelCentre(int(x), int(y));
+            int64_t e0 = edgeFunction(v1, v2, p), e1 = edgeFunction(v2, v0, p),
+                    e2 = edgeFunction(v0, v1, p);
+            if (e0 + bias0 < 0 || e1 + bias1 < 0 || e2 + bias2 < 0) continue;
+            glm::dvec3 l(double(e0) * inverseArea, double(e1) * inverseArea,
+                         double(e2) * inverseArea);
+            if (swapped) std::swap(l.y, l.z);
+            covered(int(x), int(y), l);
+        }
+    return area;
+}
+
+}  // namespace boxes

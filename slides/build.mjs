@@ -427,7 +427,12 @@ function codeExcerpt(step, names, opts) {
 function exercisesHtml(step) {
   const rows = [];
   for (const file of sourceFiles(step)) {
-    for (const line of fs.readFileSync(file, "utf8").split("\n")) {
+    const lines = fs.readFileSync(file, "utf8").split("\n");
+    for (let i = 0; i < lines.length; ++i) {
+      if (!/\/\/\s*EXERCISE\s+\d+\.\d+:/.test(lines[i])) continue;
+      // The marker, joined with the comment line after it when its "(N points)" wrapped.
+      let line = lines[i];
+      if (!/\(\d+\s+points?\)/.test(line) && /^\s*\/\//.test(lines[i + 1] || "")) line += " " + lines[i + 1].replace(/^\s*\/\/\s*/, "");
       const m = line.match(/\/\/\s*EXERCISE\s+(\d+)\.(\d+):\s*(.*?)\s*\((\d+)\s+points?\)/);
       if (m) rows.push({ major: Number(m[1]), minor: Number(m[2]), what: m[3], points: Number(m[4]), file: path.basename(file) });
     }

@@ -91,7 +91,8 @@ function loadReport(step, args) {
   reports.set(step, result);
   const json = path.join(args.out, `${step}.json`);
   const program = path.join(args.bin, "steps", step, step);
-  if (!fs.existsSync(path.join(root, "steps", step))) {
+  // A report that is not a step's own (a benchmark's, e.g. 04_bvh_bench) is read when present.
+  if (!fs.existsSync(path.join(root, "steps", step)) && !fs.existsSync(json)) {
     result.error = `steps/${step} does not exist yet`;
     return result;
   }
@@ -407,7 +408,9 @@ function codeExcerpt(step, names, opts) {
       // found: [first, last] or [marker, last, marker] when only the marker line is kept.
       let body = found.length === 3 ? [lines[found[0]]].concat(lines.slice(nextCode(lines, found[0]), found[1] + 1)) : lines.slice(found[0], found[1] + 1);
       body = body.filter((l) => !/\/\/\s*(BEGIN|END) SOLUTION/.test(l));
-      if (opts.nocomments) body = body.filter((l, i) => i === 0 || !/^\s*\/\/(?!\s*EXERCISE)/.test(l));
+      // nocomments: drop comment lines, but keep the exercise marker and its wrapped "points)".
+      const wrapped = /EXERCISE/.test(body[0]) && !/points?\)/.test(body[0]);
+      if (opts.nocomments) body = body.filter((l, i) => i === 0 || (i === 1 && wrapped) || !/^\s*\/\/(?!\s*EXERCISE)/.test(l));
       const indent = Math.min(...body.filter((l) => l.trim()).map((l) => l.match(/^\s*/)[0].length));
       body = body.map((l) => l.slice(indent));
       const max = Number(opts.max || 16);
@@ -465,7 +468,17 @@ function expand(markdown, deck, args, deckDir) {
     const step = slash < 0 ? target : target.slice(0, slash);
     const spec = slash < 0 ? "" : target.slice(slash + 1);
     if (kind === "image") return imageHtml(step, spec || optionWords.find((w) => !w.includes("=")), opts, args, deckDir);
-    if (kind === "table") return tableHtml(step, spec || "*", opts, args);
+    if (kind === "table") {
+      // STEP/ID,STEP2/ID2: the first report that has its table (a benchmark's, else the tour's).
+      const targets = target.split(",");
+      for (const t of targets.slice(0, -1)) {
+        const [s2, id2] = t.split("/");
+        const { report } = loadReport(s2, args);
+        if (report && findTable(report, id2 || "*")) return tableHtml(s2, id2 || "*", opts, args);
+      }
+      const last = targets[targets.length - 1].split("/");
+      return tableHtml(last[0], last[1] || "*", opts, args);
+    }
     if (kind === "plot") return plotHtml(step, spec, opts, args);
     return factText(step, spec, args);
   });

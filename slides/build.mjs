@@ -17,6 +17,7 @@
 //                                                     caption holds text) of the step's report
 //   <!-- table: 01_triangle/ID|~text|* [columns=a|b] [rows=N] [dense] -->
 //                                                     a measured table (first alternative found)
+//   <!-- plot: 01_triangle/N [w=560] [h=330] -->        the report's plot N, drawn as inline SVG
 //   <!-- fact: 01_triangle/name -->                   one number from the report's facts
 //   <!-- machine -->                                  the machine the deck's numbers come from
 //   <!-- exercises: 01_triangle -->                  the step's exercise markers as a table
@@ -90,7 +91,8 @@ function loadReport(step, args) {
   reports.set(step, result);
   const json = path.join(args.out, `${step}.json`);
   const program = path.join(args.bin, "steps", step, step);
-  if (!fs.existsSync(path.join(root, "steps", step))) {
+  // A report that is not a step's own (a benchmark's, e.g. 04_bvh_bench) is read when present.
+  if (!fs.existsSync(path.join(root, "steps", step)) && !fs.existsSync(json)) {
     result.error = `steps/${step} does not exist yet`;
     return result;
   }
@@ -127,7 +129,9 @@ function loadReport(step, args) {
 }
 
 function pending(step, what, error) {
-  return `<div class="pending">Step ${esc(step)}: this step is not built yet, so its ${esc(what)} is not here (${esc(error)}). Rebuild the slides once it exists: <code>cmake --build --preset release --target slides</code>.</div>`;
+  const notYet = /does not exist yet|not built yet|is missing$/.test(error);
+  const head = notYet ? "this step is not built yet" : "this step's output is not available";
+  return `<div class="pending">Step ${esc(step)}: ${head}, so its ${esc(what)} is not here (${esc(error)}). Rebuild the slides once it is: <code>cmake --build --preset release --target slides</code>.</div>`;
 }
 
 // Numbers as tools/report.py prints them.
@@ -188,6 +192,94 @@ function tableHtml(step, spec, opts, args) {
     `<div class="measured${dense}" data-table="${esc(step)}/${esc(t.id)}">` +
     `<table><thead><tr>${head}</tr></thead><tbody>${body}</tbody></table>` +
     `<p class="caption">${esc(t.title)}${more}.${note} Measured on ${esc(report.machine || "this machine")}.</p></div>`
+  );
+}
+
+// A plot spec of the report ({table, x, y, series, logx, logy, title}) drawn as inline SVG:
+// one point per row, one colour per series; on a log axis, zeros sit on a "0" line below.
+function plotHtml(step, spec, opts, args) {
+  const { report, error } = loadReport(step, args);
+  if (!report) return pending(step, "plot", error);
+  // spec: an index, or ~text found in the plot's table id or title (alternatives with |).
+  const plots = report.plots || [];
+  let plot = null;
+  for (const alt of String(spec || "0").split("|")) {
+    if (/^\d+$/.test(alt)) plot = plots[Number(alt)];
+    else if (alt.startsWith("~")) {
+      const t = alt.slice(1).toLowerCase();
+      plot = plots.find((p) => String(p.table).toLowerCase().includes(t) || String(p.title || "").toLowerCase().includes(t));
+    }
+    if (plot) break;
+  }
+  const table = plot && (report.tables || []).find((t) => t.id === plot.table);
+  if (!table) return `<p class="src">(out/${esc(step)}.json has no plot matching '${esc(spec || "0")}': see its tables.)</p>`;
+  const xi = table.columns.indexOf(plot.x), yi = table.columns.indexOf(plot.y), si = table.columns.indexOf(plot.series);
+  const pts = table.rows
+    .filter((r) => typeof r[xi] === "number" && typeof r[yi] === "number")
+    .map((r) => ({ x: r[xi], y: r[yi], s: si >= 0 ? String(r[si]) : "" }));
+  if (!pts.length) return pending(step, "plot", "no numeric points");
+  const W = Number(opts.w || 560), H = Number(opts.h || 330), R = 16, T = 14, B = 46;
+  const decade = (e) => (e >= -3 && e <= 6 ? (10 ** e).toLocaleString("en-US", { maximumFractionDigits: 3 }) : `1e${e}`);
+  const axis = (vals, log, lo, hi) => {
+    if (log) {
+      const pos = vals.filter((v) => v > 0);
+      const a = Math.floor(Math.log10(pos.length ? Math.min(...pos) : 1)), b = Math.ceil(Math.log10(pos.length ? Math.max(...pos) : 10));
+      const hasZero = vals.some((v) => v <= 0);
+      const from = hasZero ? a - 1 : a, to = Math.max(b, a + 1);
+      const map = (v) => lo + ((v > 0 ? Math.log10(v) : from) - from) / (to - from) * (hi - lo);
+      const ticks = [];
+      for (let e = from; e <= to; ++e) ticks.push({ v: hasZero && e === from ? 0 : 10 ** e, label: hasZero && e === from ? "0" : decade(e) });
+      return { map, ticks };
+    }
+    let a = Math.min(0, ...vals), b = Math.max(...vals);
+    if (b <= a) b = a + 1;
+    const step10 = 10 ** Math.floor(Math.log10((b - a) / 4));
+    const stepv = [1, 2, 5, 10].map((m) => m * step10).find((s2) => (b - a) / s2 <= 6);
+    b = Math.ceil(b / stepv) * stepv;
+    const ticks = [];
+    for (let v = a; v <= b + stepv / 2; v += stepv) ticks.push({ v, label: fmt(Number(v.toPrecision(6))) });
+    return { map: (v) => lo + (v - a) / (b - a) * (hi - lo), ticks };
+  };
+  // The left margin fits the longest y tick label and the rotated axis title.
+  const L = 34 + 7 * Math.max(...axis(pts.map((p) => p.y), !!plot.logy, 0, 1).ticks.map((t) => t.label.length));
+  const ax = axis(pts.map((p) => p.x), !!plot.logx, L, W - R);
+  const ay = axis(pts.map((p) => p.y), !!plot.logy, H - B, T);
+  const colours = ["#0969da", "#cf222e", "#1a7f37", "#8250df", "#9a6700", "#bc4c00", "#57606a", "#e85aad"];
+  const series = [...new Set(pts.map((p) => p.s))];
+  const labelPoints = series.length === pts.length && series.every(Boolean);
+  const el = [];
+  el.push(`<rect x="${L}" y="${T}" width="${W - L - R}" height="${H - T - B}" fill="none" stroke="#d1d9e0"/>`);
+  for (const t of ax.ticks) {
+    const x = ax.map(t.v).toFixed(1);
+    el.push(`<line x1="${x}" y1="${T}" x2="${x}" y2="${H - B}" stroke="#eaeef2"/><text x="${x}" y="${H - B + 16}" text-anchor="middle">${esc(t.label)}</text>`);
+  }
+  for (const t of ay.ticks) {
+    const y = ay.map(t.v).toFixed(1);
+    el.push(`<line x1="${L}" y1="${y}" x2="${W - R}" y2="${y}" stroke="#eaeef2"/><text x="${L - 6}" y="${y}" text-anchor="end" dominant-baseline="middle">${esc(t.label)}</text>`);
+  }
+  el.push(`<text x="${(L + W - R) / 2}" y="${H - 8}" text-anchor="middle">${esc(plot.x)}</text>`);
+  el.push(`<text x="14" y="${(T + H - B) / 2}" text-anchor="middle" transform="rotate(-90 14 ${(T + H - B) / 2})">${esc(plot.y)}</text>`);
+  const placed = [];
+  pts.forEach((p) => {
+    const c = colours[series.indexOf(p.s) % colours.length];
+    const x = ax.map(p.x), y = ay.map(p.y);
+    el.push(`<circle cx="${x.toFixed(1)}" cy="${y.toFixed(1)}" r="5" fill="${c}"/>`);
+    // One point per series (accuracy-against-time tables): name it beside the point.
+    if (labelPoints) {
+      // Try right-above, left-above, right-below, left-below; keep the first free, in frame.
+      const w = p.s.length * 6.6, h = 13;
+      const spots = [[x + 8, y - 7 - h], [x - 8 - w, y - 7 - h], [x + 8, y + 7], [x - 8 - w, y + 7]];
+      const inFrame = ([lx, ly]) => lx >= L && lx + w <= W && ly >= 0 && ly + h <= H;
+      const free = ([lx, ly]) => placed.every(([px, py, pw]) => lx + w < px || px + pw < lx || ly + h < py || py + h < ly);
+      const spot = spots.find((q) => inFrame(q) && free(q)) || spots.find(inFrame) || spots[0];
+      placed.push([spot[0], spot[1], w]);
+      el.push(`<text x="${spot[0].toFixed(1)}" y="${(spot[1] + h - 2).toFixed(1)}" fill="${c}">${esc(p.s)}</text>`);
+    }
+  });
+  const legend = labelPoints ? "" : series.filter(Boolean).map((name, i) => `<span style="color:${colours[i % colours.length]}">●</span> ${esc(name)}`).join(" &nbsp; ");
+  return (
+    `<div class="figure plot"><svg xmlns="http://www.w3.org/2000/svg" width="${W}" height="${H}" viewBox="0 0 ${W} ${H}" font-size="12" font-family="sans-serif" fill="#1f2328">${el.join("")}</svg>` +
+    (legend ? `<p class="caption">${legend}</p>` : "") + `</div>`
   );
 }
 
@@ -316,7 +408,9 @@ function codeExcerpt(step, names, opts) {
       // found: [first, last] or [marker, last, marker] when only the marker line is kept.
       let body = found.length === 3 ? [lines[found[0]]].concat(lines.slice(nextCode(lines, found[0]), found[1] + 1)) : lines.slice(found[0], found[1] + 1);
       body = body.filter((l) => !/\/\/\s*(BEGIN|END) SOLUTION/.test(l));
-      if (opts.nocomments) body = body.filter((l, i) => i === 0 || !/^\s*\/\/(?!\s*EXERCISE)/.test(l));
+      // nocomments: drop comment lines, but keep the exercise marker and its wrapped "points)".
+      const wrapped = /EXERCISE/.test(body[0]) && !/points?\)/.test(body[0]);
+      if (opts.nocomments) body = body.filter((l, i) => i === 0 || (i === 1 && wrapped) || !/^\s*\/\/(?!\s*EXERCISE)/.test(l));
       const indent = Math.min(...body.filter((l) => l.trim()).map((l) => l.match(/^\s*/)[0].length));
       body = body.map((l) => l.slice(indent));
       const max = Number(opts.max || 16);
@@ -336,7 +430,12 @@ function codeExcerpt(step, names, opts) {
 function exercisesHtml(step) {
   const rows = [];
   for (const file of sourceFiles(step)) {
-    for (const line of fs.readFileSync(file, "utf8").split("\n")) {
+    const lines = fs.readFileSync(file, "utf8").split("\n");
+    for (let i = 0; i < lines.length; ++i) {
+      if (!/\/\/\s*EXERCISE\s+\d+\.\d+:/.test(lines[i])) continue;
+      // The marker, joined with the comment line after it when its "(N points)" wrapped.
+      let line = lines[i];
+      if (!/\(\d+\s+points?\)/.test(line) && /^\s*\/\//.test(lines[i + 1] || "")) line += " " + lines[i + 1].replace(/^\s*\/\/\s*/, "");
       const m = line.match(/\/\/\s*EXERCISE\s+(\d+)\.(\d+):\s*(.*?)\s*\((\d+)\s+points?\)/);
       if (m) rows.push({ major: Number(m[1]), minor: Number(m[2]), what: m[3], points: Number(m[4]), file: path.basename(file) });
     }
@@ -353,7 +452,7 @@ function exercisesHtml(step) {
 
 function expand(markdown, deck, args, deckDir) {
   const deckStep = /^\d\d_/.test(deck) ? deck : null;
-  return markdown.replace(/^[ \t]*<!--\s*(image|table|fact|machine|code|exercises):?\s*(.*?)\s*-->[ \t]*$/gm, (_, kind, rest) => {
+  return markdown.replace(/^[ \t]*<!--\s*(image|table|plot|fact|machine|code|exercises):?\s*(.*?)\s*-->[ \t]*$/gm, (_, kind, rest) => {
     const words = [...rest.matchAll(/(\w+)="([^"]*)"|(\S+)/g)].map((m) => (m[3] !== undefined ? m[3] : `${m[1]}=${m[2]}`));
     if (kind === "machine") return machineHtml(deckStep, args);
     if (kind === "exercises") return exercisesHtml(words[0]);
@@ -369,7 +468,18 @@ function expand(markdown, deck, args, deckDir) {
     const step = slash < 0 ? target : target.slice(0, slash);
     const spec = slash < 0 ? "" : target.slice(slash + 1);
     if (kind === "image") return imageHtml(step, spec || optionWords.find((w) => !w.includes("=")), opts, args, deckDir);
-    if (kind === "table") return tableHtml(step, spec || "*", opts, args);
+    if (kind === "table") {
+      // STEP/ID,STEP2/ID2: the first report that has its table (a benchmark's, else the tour's).
+      const targets = target.split(",");
+      for (const t of targets.slice(0, -1)) {
+        const [s2, id2] = t.split("/");
+        const { report } = loadReport(s2, args);
+        if (report && findTable(report, id2 || "*")) return tableHtml(s2, id2 || "*", opts, args);
+      }
+      const last = targets[targets.length - 1].split("/");
+      return tableHtml(last[0], last[1] || "*", opts, args);
+    }
+    if (kind === "plot") return plotHtml(step, spec, opts, args);
     return factText(step, spec, args);
   });
 }

@@ -91,6 +91,7 @@ function inspectSlide() {
     rawMath,
     mathErrors,
     formulas: section.querySelectorAll("mjx-container").length,
+    displayFormulas: section.querySelectorAll('mjx-container[display="true"]').length,
     images: section.querySelectorAll("img").length,
   };
 }
@@ -133,7 +134,7 @@ try {
     const imageCount = await page.evaluate(() => document.images.length);
     const tableCount = await page.evaluate(() => document.querySelectorAll(".measured:not(.exercises) table").length);
 
-    let formulaSlide = 0, formulas = 0;
+    let formulaSlide = 0, anyFormulaSlide = 0, formulas = 0;
     for (let i = 1; i <= slides; ++i) {
       await page.evaluate((n) => (location.hash = `#${n}`), i);
       await page.waitForFunction((n) => {
@@ -148,10 +149,18 @@ try {
       formulas += facts.formulas || 0;
       if (args.every) await page.screenshot({ path: path.join(deckDir, "all", `${name}-${String(i).padStart(2, "0")}.png`) });
       if (i === 1) await page.screenshot({ path: path.join(deckDir, `${name}-slide1.png`) });
-      if (!formulaSlide && facts.formulas > 0) {
+      // The first slide with a displayed formula (else the first with any formula).
+      if (!formulaSlide && facts.displayFormulas > 0) {
         formulaSlide = i;
         await page.screenshot({ path: path.join(deckDir, `${name}-formula.png`) });
       }
+      if (!anyFormulaSlide && facts.formulas > 0) anyFormulaSlide = i;
+    }
+    if (!formulaSlide && anyFormulaSlide) {
+      formulaSlide = anyFormulaSlide;
+      await page.evaluate((n) => (location.hash = `#${n}`), formulaSlide);
+      await page.waitForTimeout(300);
+      await page.screenshot({ path: path.join(deckDir, `${name}-formula.png`) });
     }
     if (!formulas) failures.push("no formula rendered anywhere in the deck");
     // Once a step exists and has been run, its deck must show its picture and its numbers.

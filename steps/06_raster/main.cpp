@@ -134,9 +134,9 @@ int main(int argc, char** argv) {
                       << formatSeconds(shaded.milliseconds * 1e-3) << ")\n";
             if (compare) {
                 TracedFrame traced = traceFrame(scene, scene.camera, rs.width, rs.height, true, 1);
-                VisibilityComparison c =
-                    compareVisibility(rs.width, rs.height, meshIds(raster, buffers),
-                                      meshDepths(raster, buffers), traced.ids, traced.depth);
+                VisibilityComparison c = compareVisibility(
+                    rs.width, rs.height, meshIds(raster, buffers), meshDepths(raster, buffers),
+                    traced.ids, traced.depth, &scene.mesh);
                 std::string diff = withSuffix(out, "-diff.png");
                 differenceImage(rs.width, rs.height, meshIds(raster, buffers), traced.ids)
                     .writePng(diff);
@@ -277,7 +277,7 @@ int main(int argc, char** argv) {
                 tracedMs = traced.milliseconds;
                 std::vector<uint32_t> ids = meshIds(raster, buffers);
                 diff = compareVisibility(rs.width, rs.height, ids, meshDepths(raster, buffers),
-                                         traced.ids, traced.depth);
+                                         traced.ids, traced.depth, &scene.mesh);
                 image = differenceImage(rs.width, rs.height, ids, traced.ids);
             }
             dirty = false;

@@ -102,7 +102,7 @@ Table measureVisibility(const std::vector<MeasureView>& views, const MeasureSett
         TracedFrame traced = traceFrame(v.scene, v.camera, m.width, m.height, false, 0);
         VisibilityComparison c =
             compareVisibility(m.width, m.height, meshIds(raster, buffers),
-                              meshDepths(raster, buffers), traced.ids, traced.depth);
+                              meshDepths(raster, buffers), traced.ids, traced.depth, &v.scene.mesh);
         t.row({v.name, (long long)raster.meshTriangles, (long long)c.coveredRaster,
                (long long)c.coveredTraced, 100.0 * c.agreement(), (long long)c.differOnEdge,
                (long long)c.differElsewhere, 100.0 * c.coverageDifference(), c.maxDepthError});
@@ -173,7 +173,7 @@ Table measureShadowBias(const MeasureView& v, const MeasureSettings& m) {
     rasterizeFrame(raster, v.camera, rasterSettings(m), buffers);
     TracedFrame traced = traceFrame(v.scene, v.camera, m.width, m.height, true, 0);
     std::vector<uint32_t> ids = meshIds(raster, buffers);
-    for (int size : {1024, 4096}) {
+    for (int size : {1024, 2048}) {
         std::vector<ShadowMap> maps;
         for (const PointLight& light : v.scene.lights)
             maps.push_back(buildShadowMap(raster, light, size));

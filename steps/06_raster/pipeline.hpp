@@ -38,6 +38,7 @@ struct RasterSettings {
     bool backfaceCulling = false;
     bool perspectiveCorrect = true;  // false: affine weights (textures and normals warp)
     double guardBand = 64.0;         // clip |x|, |y| <= guardBand * w
+    bool depthOnly = false;          // only the depth buffer (a shadow map)
 };
 
 // Near and far planes for a view: the settings' own when given (checked: 0 < near < far),
@@ -53,7 +54,7 @@ struct FrameBuffers {
     std::vector<uint32_t> triangle;  // kNoPrimitive where nothing is drawn
     std::vector<float> depth;        // +infinity where nothing is drawn
     std::vector<float> weight1, weight2;
-    void reset(int w, int h);
+    void reset(int w, int h, bool depthOnly = false);
     size_t index(int x, int y) const { return size_t(y) * size_t(width) + size_t(x); }
 };
 

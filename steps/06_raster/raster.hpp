@@ -104,12 +104,14 @@ glm::dvec3 perspectiveCorrectWeights(const glm::dvec3& screen, const glm::dvec3&
 // The pixels a triangle covers: calls covered(x, y, screenWeights) for every pixel centre
 // inside the triangle under the top-left rule, within [0, width) x [0, height). The
 // vertices may come in either winding; zero area draws nothing. Returns the signed area
-// (twice, in fixed point) so callers can cull back faces before drawing.
+// (twice, in fixed point); with cullBackFaces a back face (E > 0, see below) draws nothing.
 template <typename Covered>
 int64_t rasterizeTriangle(FixedPoint2 v0, FixedPoint2 v1, FixedPoint2 v2, int width, int height,
-                          bool cullNegative, Covered&& covered) {
+                          bool cullBackFaces, Covered&& covered) {
     int64_t area = edgeFunction(v0, v1, v2);
-    if (area == 0 || (cullNegative && area < 0)) return area;
+    // A front face (counter-clockwise seen by the camera, the OBJ convention) turns clockwise
+    // on the y-down screen: E(v0, v1, v2) < 0. A back face has E > 0.
+    if (area == 0 || (cullBackFaces && area > 0)) return area;
     // Work on the positive winding; remember to swap the weights of vertices 1 and 2 back.
     bool swapped = area < 0;
     if (swapped) std::swap(v1, v2);

@@ -127,17 +127,10 @@ TEST_SUITE("renderer") {
         for (const char* name : {"spheres", "diffuse", "mirrors", "glass", "single-sphere", "small-lights"}) {
             INFO(name);
             Scene scene = makeScene(name, SceneOptions{test::dataDir(), 4.0f / 3.0f});
-            RenderSettings s;
-            s.width = 40;
-            s.height = 30;
-            s.maxDepth = 4;
-            RayCounts lean, forced;
-            Image a = renderImage(scene, scene.camera, s, &lean);
-            s.forceAllEffects = true;
-            Image b = renderImage(scene, scene.camera, s, &forced);
-            CHECK(a.pixels() == b.pixels());
-            CHECK(lean.total() < forced.total());
-            CHECK(lean.primary == forced.primary);
+            auto c = test::renderBothWays(scene, 40, 30, 4);
+            CHECK(c.identical);
+            CHECK(c.lean.total() < c.forced.total());
+            CHECK(c.lean.primary == c.forced.primary);
         }
     }
     TEST_CASE("effects on demand: what each scene needs") {

@@ -261,18 +261,12 @@ TEST_SUITE("renderer") {
     TEST_CASE("effects on demand: a mesh scene renders the same image with fewer rays") {
         Scene scene = makeScene("sh1", SceneOptions{test::dataDir(), 4.0f / 3.0f});
         scene.geometries.push_back(std::make_shared<TriangleGrid>(scene.mesh, scene.meshMaterial));
-        RenderSettings s;
-        s.width = 48;
-        s.height = 36;
-        RayCounts lean, forced;
-        Image a = renderImage(scene, scene.camera, s, &lean);
-        s.forceAllEffects = true;
-        Image b = renderImage(scene, scene.camera, s, &forced);
-        CHECK(a.pixels() == b.pixels());
-        CHECK(lean.total() < forced.total());
-        CHECK(lean.reflection == 0);
-        CHECK(forced.reflection > 0);
-        CHECK(lean.shadow > 0);  // a mesh can shadow itself
+        auto c = test::renderBothWays(scene, 48, 36);
+        CHECK(c.identical);
+        CHECK(c.lean.total() < c.forced.total());
+        CHECK(c.lean.reflection == 0);
+        CHECK(c.forced.reflection > 0);
+        CHECK(c.lean.shadow > 0);  // a mesh can shadow itself
     }
 }
 
@@ -304,7 +298,7 @@ TEST_SUITE("program 01") {
         auto run = test::runProgram(program,
                                     "--scene sh1 --width 64 --height 48 --frames 4 --keys t,m,t,Left "
                                     "--screenshot shot.png",
-                                    dir, "SDL_VIDEODRIVER=offscreen");
+                                    dir, test::kWindowEnvironment);
         INFO(run.err);
         REQUIRE(run.exitCode == 0);
         CHECK(test::pngSize(dir.file("shot.png")).first > 0);

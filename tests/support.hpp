@@ -11,6 +11,7 @@
 #include <string>
 
 #include "core/math.hpp"
+#include "core/render.hpp"
 
 namespace boxes::test {
 
@@ -36,6 +37,11 @@ inline std::string readText(const std::string& path) {
     s << in.rdbuf();
     return s.str();
 }
+
+// Environment for scripted window runs: SDL's offscreen driver (EGL on Mesa, no display).
+// Mesa's drivers leave allocations behind when they are unloaded at exit, which
+// LeakSanitizer reports from "unknown modules": leak checks are off for these runs only.
+constexpr const char* kWindowEnvironment = "SDL_VIDEODRIVER=offscreen ASAN_OPTIONS=detect_leaks=0";
 
 struct ProgramRun {
     int exitCode = -1;
@@ -81,6 +87,25 @@ void checkVec(const A& actual, const B& expected, double tolerance) {
                           << double(expected[i]));
         CHECK(std::abs(double(actual[i]) - double(expected[i])) <= tolerance);
     }
+}
+
+// Renders a scene once with the renderer's analysis and once with every effect forced on
+// (WORKBOOK.md, promise 3): the images must be identical, the ray counts may differ.
+struct EffectsComparison {
+    RayCounts lean, forced;
+    bool identical = false;
+};
+inline EffectsComparison renderBothWays(const Scene& scene, int width, int height, int maxDepth = 5) {
+    RenderSettings s;
+    s.width = width;
+    s.height = height;
+    s.maxDepth = maxDepth;
+    EffectsComparison c;
+    Image a = renderImage(scene, scene.camera, s, &c.lean);
+    s.forceAllEffects = true;
+    Image b = renderImage(scene, scene.camera, s, &c.forced);
+    c.identical = a.pixels() == b.pixels();
+    return c;
 }
 
 }  // namespace boxes::test

@@ -2,7 +2,10 @@
 # Installs the Debian packages a workbook command needs, when they are missing.
 # usage: tools/deps.sh GROUP...   (groups: build test report slides fuzz grade bench)
 # As root it runs apt-get; otherwise it prints the exact apt-get line and exits 1.
+# The group slides also installs the slides' npm packages (Marp, playwright-core) with
+# `npm ci --prefix slides` from slides/package-lock.json when they are missing or stale.
 set -euo pipefail
+root=$(cd "$(dirname "$0")/.." && pwd)
 
 pkgs_for() {
   case "$1" in
@@ -13,7 +16,10 @@ pkgs_for() {
     ;;
   test) echo python3 ;;
   report) echo python3 python3-matplotlib ;;
-  slides) echo chromium ;;
+  slides)
+    echo chromium
+    command -v node >/dev/null 2>&1 || echo nodejs npm # Debian's Node.js only when none is installed
+    ;;
   fuzz) echo clang libclang-rt-dev ;;
   grade) echo bubblewrap python3 ;;
   bench) echo libbenchmark-dev libembree-dev python3-numpy ;;
@@ -22,6 +28,18 @@ pkgs_for() {
     exit 2
     ;;
   esac
+}
+
+slides_npm() { # npm ci --prefix slides, when the group slides is asked for and the lock is newer
+  [[ " $* " == *" slides "* ]] || return 0
+  local stamp=$root/slides/node_modules/.package-lock.json
+  [[ -f $stamp && ! $root/slides/package-lock.json -nt $stamp ]] && return 0
+  echo "[deps] npm ci --prefix slides (Marp and playwright-core, pinned in slides/package-lock.json)" >&2
+  if ! npm ci --prefix "$root/slides" --no-audit --no-fund >/tmp/boxes-npm.log 2>&1; then
+    echo "[deps] npm ci failed; see /tmp/boxes-npm.log" >&2
+    tail -5 /tmp/boxes-npm.log >&2
+    exit 1
+  fi
 }
 
 wanted=()
@@ -36,7 +54,10 @@ for p in "${wanted[@]}"; do
 done
 # de-duplicate while keeping order
 mapfile -t missing < <(printf '%s\n' "${missing[@]}" | awk 'NF && !seen[$0]++')
-[[ ${#missing[@]} -eq 0 ]] && exit 0
+if [[ ${#missing[@]} -eq 0 ]]; then
+  slides_npm "$@"
+  exit 0
+fi
 
 line="apt-get install -y --no-install-recommends ${missing[*]}"
 if [[ $(id -u) -ne 0 ]]; then
@@ -54,3 +75,4 @@ if ! apt-get install -y --no-install-recommends "${missing[@]}" >/tmp/boxes-apt.
     exit 1
   }
 fi
+slides_npm "$@"

@@ -9,9 +9,7 @@ import glob
 import html
 import json
 import os
-import re
 import sys
-import xml.etree.ElementTree as ET
 
 import matplotlib
 
@@ -19,40 +17,13 @@ matplotlib.use("Agg")
 import matplotlib.pyplot as plt  # noqa: E402
 
 ROOT = os.path.dirname(os.path.dirname(os.path.abspath(__file__)))
-EXERCISE = re.compile(r"//\s*EXERCISE\s+(\d+\.\d+):\s*(.*?)\s*\((\d+)\s+points?\)")
+sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
+from exercises import exercises as marked_exercises, suite_results  # noqa: E402
 
 
 def exercises():
     """(id, title, points, file) for every exercise marker in the steps' sources."""
-    found = []
-    for path in sorted(glob.glob(os.path.join(ROOT, "steps", "*", "*.[ch]pp"))):
-        with open(path, encoding="utf-8") as f:
-            for line in f:
-                m = EXERCISE.search(line)
-                if m:
-                    found.append((m.group(1), m.group(2), int(m.group(3)), os.path.relpath(path, ROOT)))
-    return sorted(found, key=lambda e: tuple(int(x) for x in e[0].split(".")))
-
-
-def suite_results(out):
-    """{suite name: (passed, failed)} from doctest XML files."""
-    results = {}
-    for path in glob.glob(os.path.join(out, "test_*.xml")):
-        try:
-            tree = ET.parse(path)
-        except ET.ParseError:
-            continue
-        for suite in tree.getroot().iter("TestSuite"):
-            name = suite.get("name", "")
-            passed, failed = results.get(name, (0, 0))
-            for case in suite.iter("TestCase"):
-                res = case.find("OverallResultsAsserts")
-                ok = res is not None and res.get("failures", "0") == "0" and res.get("test_case_success", "true") == "true"
-                if case.find("Exception") is not None:
-                    ok = False
-                passed, failed = (passed + 1, failed) if ok else (passed, failed + 1)
-            results[name] = (passed, failed)
-    return results
+    return [(e.id, e.title, e.points, e.path) for e in marked_exercises(ROOT)]
 
 
 def table_html(t):

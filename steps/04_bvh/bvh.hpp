@@ -1,0 +1,280 @@
+// Step 04: a bounding volume hierarchy over triangles (or any primitives with bounds).
+//
+// Layout (after Bikker's tinybvh and pbrt's LinearBVHNode): one array of 32-byte nodes,
+// two per cache line; the children of an interior node are adjacent (left, left + 1), so
+// a node needs one index; a leaf names a range of "slots" in primitiveIndices, which the
+// builder reorders so every leaf's primitives are contiguous. For meshes the triangles'
+// vertices are also copied in slot order (leafTriangles): the leaf test reads them
+// sequentially instead of chasing two indices per triangle.
+//
+// Builders share one recursive framework (buildBvh); what differs is how a node's
+// primitives are split, and that is the exercises: 4.1 midpoint, 4.2 object median,
+// 4.3 binned SAH. A full-sweep SAH builder (not an exercise) is the quality reference.
+// Traversal (4.4 nearest hit, 4.5 any hit) is a template over the primitive test, so the
+// same loop serves triangles, tests with a reference triangle test, and anything else.
+#pragma once
+
+#include <array>
+#include <cstdint>
+#include <span>
+#include <string>
+#include <vector>
+
+#include "core/bounds.hpp"
+#include "core/exercise.hpp"
+#include "core/mesh.hpp"
+#include "core/ray.hpp"
+
+namespace boxes {
+
+// 32 bytes: bounds, then leftFirst (interior: index of the left child, the right child is
+// leftFirst + 1; leaf: first slot) and count (0 for an interior node, else the leaf's size).
+struct alignas(32) BvhNode {
+    Vec3 boundsMin{kInfinity<float>};
+    uint32_t leftFirst = 0;
+    Vec3 boundsMax{-kInfinity<float>};
+    uint32_t count = 0;
+
+    bool isLeaf() const { return count != 0; }
+    Bounds3f bounds() const { return {boundsMin, boundsMax}; }
+};
+static_assert(sizeof(BvhNode) == 32, "two nodes per 64-byte cache line");
+
+// A triangle's vertices, stored in leaf-slot order for the leaf test.
+struct LeafTriangle {
+    Vec3 a, b, c;
+};
+
+struct Bvh {
+    std::vector<BvhNode> nodes;               // nodes[0] is the root (when not empty)
+    std::vector<uint32_t> primitiveIndices;   // slot -> primitive (triangle index in file order)
+    std::vector<LeafTriangle> leafTriangles;  // meshes only: vertices per slot
+
+    bool empty() const { return nodes.empty(); }
+    Bounds3f bounds() const { return empty() ? Bounds3f() : nodes[0].bounds(); }
+};
+
+enum class BvhBuilder { Midpoint, Median, BinnedSah, SweepSah };
+constexpr BvhBuilder kExerciseBuilders[] = {BvhBuilder::Midpoint, BvhBuilder::Median,
+                                            BvhBuilder::BinnedSah};
+const char* bvhBuilderName(BvhBuilder builder);       // "midpoint", "median", "sah", "sweep-sah"
+BvhBuilder parseBvhBuilder(const std::string& name);  // throws InputError
+
+struct BvhBuildOptions {
+    BvhBuilder builder = BvhBuilder::BinnedSah;
+    int bins = 16;         // binned SAH: candidate planes per axis are bins - 1
+    int leafSize = 4;      // midpoint / median: a node with at most this many is a leaf
+    int maxLeafSize = 16;  // SAH: a node may become a leaf (when cheaper) up to this size
+    int maxDepth = 64;     // below this a node becomes a leaf, whatever its size
+    // SAH constants: cost of a node visit and of a primitive test (Goldsmith & Salmon 1987,
+    // MacDonald & Booth 1990). Only their ratio matters for the tree.
+    float traversalCost = 1.0f;
+    float intersectionCost = 1.0f;
+};
+
+// Per build: what the report prints for every hierarchy.
+struct BvhBuildStats {
+    double buildMs = 0.0;  // the build only (primitive bounds included, file reading not)
+    size_t nodes = 0, leaves = 0;
+    size_t minLeafSize = 0, maxLeafSize = 0;
+    double meanLeafSize = 0.0;
+    int depth = 0;         // the deepest leaf; the root is depth 0
+    double sahCost = 0.0;  // see bvhSahCost
+};
+
+// A primitive during the build: its bounds, their centroid, its index.
+struct BuildPrimitive {
+    Bounds3f bounds;
+    Vec3 centroid;
+    uint32_t index;
+};
+
+// The split rules. Each reorders `prims` (one node's primitives) and returns how many go
+// to the left child (the first ones). Returning 0 or prims.size() means "no useful split";
+// the framework then makes a leaf when it may, else splits the range in the middle.
+
+// Exercise 4.1: midpoint split: the middle of the centroid bounds' longest axis.
+size_t partitionMidpoint(std::span<BuildPrimitive> prims, const Bounds3f& centroidBounds);
+
+// Exercise 4.2: object median: half of the primitives (by centroid) on each side, along
+// the centroid bounds' longest axis.
+size_t partitionMedian(std::span<BuildPrimitive> prims, const Bounds3f& centroidBounds);
+
+// Exercise 4.3: binned SAH (Wald 2007): centroids into `bins` equal bins per axis, the
+// split between bins with the least SAH cost. Sets `cost` to that split's cost,
+// traversalCost + intersectionCost * (A_L N_L + A_R N_R) / A_node, and returns 0 (cost
+// infinity) when no axis can be split (all centroids equal).
+size_t partitionBinnedSah(std::span<BuildPrimitive> prims, const Bounds3f& nodeBounds,
+                          const Bounds3f& centroidBounds, const BvhBuildOptions& options,
+                          float& cost);
+
+// Not an exercise: the full-sweep SAH split (every primitive boundary on every axis), the
+// reference the binned builder's quality is measured against. O(n log n) per node.
+size_t partitionSweepSah(std::span<BuildPrimitive> prims, const Bounds3f& nodeBounds,
+                         const BvhBuildOptions& options, float& cost);
+
+// Builds the hierarchy over primitives with the given bounds (index = position).
+// Handles every input: empty lists, identical centroids, flat boxes, huge counts.
+Bvh buildBvh(std::span<const Bounds3f> primitiveBounds, const BvhBuildOptions& options,
+             BvhBuildStats* stats = nullptr);
+// The same over a mesh's triangles, also filling leafTriangles.
+Bvh buildBvh(const Mesh& mesh, const BvhBuildOptions& options, BvhBuildStats* stats = nullptr);
+
+// SAH cost of a built tree: sum over interior nodes of traversalCost * A(node) / A(root)
+// plus over leaves of intersectionCost * count * A(leaf) / A(root).
+double bvhSahCost(const Bvh& bvh, float traversalCost = 1.0f, float intersectionCost = 1.0f);
+// Nodes, leaves, leaf sizes, depth and the SAH cost (buildMs left 0).
+BvhBuildStats bvhStats(const Bvh& bvh, const BvhBuildOptions& options);
+
+// ---------------------------------------------------------------------------------------
+// Traversal.
+
+// A ray prepared for box tests: reciprocal direction (+-infinity for a zero component),
+// and the origin moved by a margin, so the box test is conservative with respect to the
+// watertight triangle test. That test translates the vertices to the ray origin and shears
+// them, rounding each time: it can report a hit up to a few float steps of |vertex - O|
+// outside the exact triangle (Woop, Benthin, Wald 2013, section 4: the box test must
+// allow for the same error). We widen each box by
+//   margin = 64 * 2^-24 * (|O - centre| + radius)   (the root's bounding sphere),
+// an upper bound of that error for every vertex in the tree, folded into two origins:
+// minimum planes use O + margin and maximum planes O - margin (same cost as one origin).
+struct TraversalRay {
+    Vec3 originForMin, originForMax, direction, inverseDirection;
+    float tmin, tmax;
+    explicit TraversalRay(const Ray& ray, float margin = 0.0f)
+        : originForMin(ray.origin + Vec3(margin)),
+          originForMax(ray.origin - Vec3(margin)),
+          direction(ray.direction),
+          inverseDirection(1.0f / ray.direction.x, 1.0f / ray.direction.y,
+                           1.0f / ray.direction.z),
+          tmin(ray.tmin),
+          tmax(ray.tmax) {}
+    // The margin for the triangles of `bvh` (see above).
+    TraversalRay(const Ray& ray, const Bvh& bvh) : TraversalRay(ray, marginFor(ray, bvh)) {}
+
+    static float marginFor(const Ray& ray, const Bvh& bvh) {
+        if (bvh.empty()) return 0.0f;
+        Bounds3f b = bvh.bounds();
+        float radius = 0.5f * glm::length(b.diagonal());
+        return 64.0f * 0x1p-24f * (glm::length(ray.origin - b.centroid()) + radius);
+    }
+};
+
+// 1 + 2 gamma(3), gamma(n) = n eps / (1 - n eps) with eps = 2^-24 (pbrt-v4, Ize 2013):
+// widening the slab test's far distance by it makes the float slab test itself
+// conservative (its own roundings never drop a box the exact ray touches).
+constexpr float kBoxFarScale = 1.0f + 2.0f * (3.0f * 0x1p-24f) / (1.0f - 3.0f * 0x1p-24f);
+
+// The conservative slab test against a node's box in [ray.tmin, tmax]; tEntry is where the
+// ray enters (>= ray.tmin). Not step 03's exercise: the hierarchy needs its own copy.
+// 0 * infinity (origin on a slab plane, zero direction component) gives NaN, and the
+// comparisons below ignore a NaN bound: the ray lies in that plane, and the closed box
+// contains it along that axis. Components through pointers: glm's operator[] is a switch.
+inline bool intersectNodeBounds(const BvhNode& node, const TraversalRay& ray, float tmax,
+                                float& tEntry) {
+    const float *lo = &node.boundsMin.x, *hi = &node.boundsMax.x;
+    const float *oLo = &ray.originForMin.x, *oHi = &ray.originForMax.x;
+    const float* inv = &ray.inverseDirection.x;
+    float t0 = ray.tmin, t1 = tmax;
+    for (int axis = 0; axis < 3; ++axis) {
+        float tNear = (lo[axis] - oLo[axis]) * inv[axis];
+        float tFar = (hi[axis] - oHi[axis]) * inv[axis];
+        if (tNear > tFar) std::swap(tNear, tFar);
+        tFar *= kBoxFarScale;
+        t0 = tNear > t0 ? tNear : t0;
+        t1 = tFar < t1 ? tFar : t1;
+    }
+    tEntry = t0;
+    return t0 <= t1;
+}
+
+// Depth of the traversal stack: the builders cap the depth below it.
+constexpr int kTraversalStackSize = 128;
+
+// EXERCISE 4.4: nearest-hit traversal: nearer child first, early out (4 points)
+// intersect(slot, tClosest) tests the primitive in leaf slot `slot` for a hit in
+// [ray.tmin, tClosest], and on a hit lowers tClosest and returns true. Returns the slot of
+// the nearest hit (tClosest its distance), or kTraversalMiss. Skip every node the ray
+// enters beyond tClosest; visit the child the ray enters first before the other.
+constexpr uint32_t kTraversalMiss = 0xFFFFFFFFu;
+template <typename PrimitiveIntersector>
+uint32_t traverseNearest(const Bvh& bvh, const TraversalRay& ray, float& tClosest,
+                         PrimitiveIntersector&& intersect) {
+    // BEGIN SOLUTION
+    if (bvh.nodes.empty()) return kTraversalMiss;
+    uint32_t nearestSlot = kTraversalMiss;
+    const BvhNode* nodes = bvh.nodes.data();
+    uint32_t stack[kTraversalStackSize];
+    int stackSize = 0;
+    float tRoot;
+    if (!intersectNodeBounds(nodes[0], ray, tClosest, tRoot)) return kTraversalMiss;
+    uint32_t current = 0;
+    for (;;) {
+        const BvhNode& node = nodes[current];
+        if (node.isLeaf()) {
+            for (uint32_t slot = node.leftFirst; slot < node.leftFirst + node.count; ++slot)
+                if (intersect(slot, tClosest)) nearestSlot = slot;
+        } else {
+            // Both children at once: descend into the nearer, keep the farther for later.
+            uint32_t near = node.leftFirst, far = node.leftFirst + 1;
+            float tNear, tFar;
+            bool hitNear = intersectNodeBounds(nodes[near], ray, tClosest, tNear);
+            bool hitFar = intersectNodeBounds(nodes[far], ray, tClosest, tFar);
+            if (hitNear && hitFar) {
+                if (tFar < tNear) std::swap(near, far);
+                stack[stackSize++] = far;
+                current = near;
+                continue;
+            }
+            if (hitNear || hitFar) {
+                current = hitNear ? near : far;
+                continue;
+            }
+        }
+        // Pop until a node the ray can still reach before tClosest (entry test again: the
+        // hit may have come closer since it was pushed).
+        bool found = false;
+        while (stackSize > 0) {
+            uint32_t candidate = stack[--stackSize];
+            float tEntry;
+            if (intersectNodeBounds(nodes[candidate], ray, tClosest, tEntry)) {
+                current = candidate;
+                found = true;
+                break;
+            }
+        }
+        if (!found) break;
+    }
+    return nearestSlot;
+    // END SOLUTION
+}
+
+// EXERCISE 4.5: any-hit traversal for shadow rays: stop at the first hit (2 points)
+// intersect(slot, tmax) returns true when the primitive in `slot` is hit in
+// [ray.tmin, tmax]. Returns true as soon as any primitive is hit in [ray.tmin, ray.tmax].
+template <typename PrimitiveIntersector>
+bool traverseAny(const Bvh& bvh, const TraversalRay& ray, PrimitiveIntersector&& intersect) {
+    // BEGIN SOLUTION
+    if (bvh.nodes.empty()) return false;
+    const BvhNode* nodes = bvh.nodes.data();
+    uint32_t stack[kTraversalStackSize];
+    int stackSize = 0;
+    stack[stackSize++] = 0;
+    while (stackSize > 0) {
+        const BvhNode& node = nodes[stack[--stackSize]];
+        float tEntry;
+        if (!intersectNodeBounds(node, ray, ray.tmax, tEntry)) continue;
+        if (node.isLeaf()) {
+            for (uint32_t slot = node.leftFirst; slot < node.leftFirst + node.count; ++slot)
+                if (intersect(slot, ray.tmax)) return true;
+        } else {
+            // No order is needed: any hit ends the search.
+            stack[stackSize++] = node.leftFirst + 1;
+            stack[stackSize++] = node.leftFirst;
+        }
+    }
+    return false;
+    // END SOLUTION
+}
+
+}  // namespace boxes

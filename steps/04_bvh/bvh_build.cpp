@@ -1,0 +1,360 @@
+// The builders: the recursive framework and the split rules (exercises 4.1 to 4.3).
+#include <algorithm>
+#include <numeric>
+
+#include "04_bvh/bvh.hpp"
+#include "core/timing.hpp"
+
+namespace boxes {
+
+const char* bvhBuilderName(BvhBuilder builder) {
+    switch (builder) {
+        case BvhBuilder::Midpoint:
+            return "midpoint";
+        case BvhBuilder::Median:
+            return "median";
+        case BvhBuilder::BinnedSah:
+            return "sah";
+        default:
+            return "sweep-sah";
+    }
+}
+
+BvhBuilder parseBvhBuilder(const std::string& name) {
+    for (BvhBuilder b :
+         {BvhBuilder::Midpoint, BvhBuilder::Median, BvhBuilder::BinnedSah, BvhBuilder::SweepSah})
+        if (name == bvhBuilderName(b)) return b;
+    throw InputError("unknown builder '" + name + "' (use midpoint, median, sah or sweep-sah)");
+}
+
+// EXERCISE 4.1: midpoint split along the longest axis of the centroid bounds (2 points)
+size_t partitionMidpoint(std::span<BuildPrimitive> prims, const Bounds3f& centroidBounds) {
+    // BEGIN SOLUTION
+    int axis = centroidBounds.maxExtentAxis();
+    float middle = centroidBounds.centroid()[axis];
+    // Every centroid equal along the axis: all land on one side and the framework decides.
+    auto right = std::partition(prims.begin(), prims.end(),
+                                [&](const BuildPrimitive& p) { return p.centroid[axis] < middle; });
+    return size_t(right - prims.begin());
+    // END SOLUTION
+}
+
+// EXERCISE 4.2: object median split along the longest axis of the centroid bounds (2 points)
+size_t partitionMedian(std::span<BuildPrimitive> prims, const Bounds3f& centroidBounds) {
+    // BEGIN SOLUTION
+    int axis = centroidBounds.maxExtentAxis();
+    size_t half = prims.size() / 2;
+    // nth_element: the median in place, smaller before, larger after, in O(n).
+    std::nth_element(prims.begin(), prims.begin() + std::ptrdiff_t(half), prims.end(),
+                     [&](const BuildPrimitive& a, const BuildPrimitive& b) {
+                         return a.centroid[axis] < b.centroid[axis];
+                     });
+    return half;
+    // END SOLUTION
+}
+
+namespace {
+
+constexpr int kMaxBins = 256;
+
+struct SahBin {
+    Bounds3f bounds;
+    uint32_t count = 0;
+};
+
+}  // namespace
+
+// EXERCISE 4.3: binned SAH split (5 points)
+size_t partitionBinnedSah(std::span<BuildPrimitive> prims, const Bounds3f& nodeBounds,
+                          const Bounds3f& centroidBounds, const BvhBuildOptions& options,
+                          float& cost) {
+    // BEGIN SOLUTION
+    cost = kInfinity<float>;
+    int bins = std::clamp(options.bins, 2, kMaxBins);
+    float nodeArea = nodeBounds.surfaceArea();
+    // A node without area (all primitives on one line) gives no guidance: no split.
+    if (!(nodeArea > 0.0f)) return 0;
+    int bestAxis = -1, bestPlane = 0;
+    float bestScale = 0.0f;
+    Vec3 extent = centroidBounds.diagonal();
+    for (int axis = 0; axis < 3; ++axis) {
+        // A zero extent has nothing to split (and would divide by zero below).
+        if (!(extent[axis] > 0.0f)) continue;
+        float scale = float(bins) / extent[axis];
+        if (!std::isfinite(scale) || !(scale > 0.0f)) continue;
+        SahBin bin[kMaxBins];
+        for (const BuildPrimitive& p : prims) {
+            int b = std::min(bins - 1, int((p.centroid[axis] - centroidBounds.min[axis]) * scale));
+            bin[b].count++;
+            bin[b].bounds.extend(p.bounds.min);
+            bin[b].bounds.extend(p.bounds.max);
+        }
+        // Sweep from the right: area and count right of each plane; then from the left.
+        float rightArea[kMaxBins];
+        uint32_t rightCount[kMaxBins];
+        Bounds3f right;
+        uint32_t count = 0;
+        for (int plane = bins - 1; plane > 0; --plane) {
+            count += bin[plane].count;
+            if (bin[plane].count) {
+                right.extend(bin[plane].bounds.min);
+                right.extend(bin[plane].bounds.max);
+            }
+            rightArea[plane] = right.surfaceArea();
+            rightCount[plane] = count;
+        }
+        Bounds3f left;
+        count = 0;
+        for (int plane = 1; plane < bins; ++plane) {
+            count += bin[plane - 1].count;
+            if (bin[plane - 1].count) {
+                left.extend(bin[plane - 1].bounds.min);
+                left.extend(bin[plane - 1].bounds.max);
+            }
+            if (count == 0 || rightCount[plane] == 0) continue;
+            float c = options.traversalCost + options.intersectionCost *
+                                                  (left.surfaceArea() * float(count) +
+                                                   rightArea[plane] * float(rightCount[plane])) /
+                                                  nodeArea;
+            if (c < cost) {
+                cost = c;
+                bestAxis = axis;
+                bestPlane = plane;
+                bestScale = scale;
+            }
+        }
+    }
+    if (bestAxis < 0) return 0;
+    // Partition with the same bin arithmetic, so every primitive lands where it was counted.
+    auto middle = std::partition(prims.begin(), prims.end(), [&](const BuildPrimitive& p) {
+        int b = std::min(bins - 1,
+                         int((p.centroid[bestAxis] - centroidBounds.min[bestAxis]) * bestScale));
+        return b < bestPlane;
+    });
+    return size_t(middle - prims.begin());
+    // END SOLUTION
+}
+
+size_t partitionSweepSah(std::span<BuildPrimitive> prims, const Bounds3f& nodeBounds,
+                         const BvhBuildOptions& options, float& cost) {
+    cost = kInfinity<float>;
+    size_t n = prims.size();
+    float nodeArea = nodeBounds.surfaceArea();
+    if (n < 2 || !(nodeArea > 0.0f)) return 0;
+    int bestAxis = -1;
+    size_t bestLeft = 0;
+    std::vector<float> rightArea(n);
+    for (int axis = 0; axis < 3; ++axis) {
+        std::sort(prims.begin(), prims.end(),
+                  [&](const BuildPrimitive& a, const BuildPrimitive& b) {
+                      return a.centroid[axis] < b.centroid[axis] ||
+                             (a.centroid[axis] == b.centroid[axis] && a.index < b.index);
+                  });
+        Bounds3f right;
+        for (size_t i = n; i-- > 1;) {
+            right.extend(prims[i].bounds.min);
+            right.extend(prims[i].bounds.max);
+            rightArea[i] = right.surfaceArea();
+        }
+        Bounds3f left;
+        for (size_t i = 1; i < n; ++i) {
+            left.extend(prims[i - 1].bounds.min);
+            left.extend(prims[i - 1].bounds.max);
+            // Only between different centroids: a plane must separate them.
+            if (prims[i - 1].centroid[axis] == prims[i].centroid[axis]) continue;
+            float c = options.traversalCost +
+                      options.intersectionCost *
+                          (left.surfaceArea() * float(i) + rightArea[i] * float(n - i)) / nodeArea;
+            if (c < cost) {
+                cost = c;
+                bestAxis = axis;
+                bestLeft = i;
+            }
+        }
+    }
+    if (bestAxis < 0) return 0;
+    std::sort(prims.begin(), prims.end(), [&](const BuildPrimitive& a, const BuildPrimitive& b) {
+        return a.centroid[bestAxis] < b.centroid[bestAxis] ||
+               (a.centroid[bestAxis] == b.centroid[bestAxis] && a.index < b.index);
+    });
+    return bestLeft;
+}
+
+namespace {
+
+class BvhBuildJob {
+  public:
+    BvhBuildJob(std::vector<BuildPrimitive>& prims, const BvhBuildOptions& options, Bvh& bvh)
+        : prims_(prims), options_(options), bvh_(bvh) {}
+
+    void build() {
+        bvh_.nodes.clear();
+        if (prims_.empty()) return;
+        bvh_.nodes.reserve(2 * prims_.size());
+        bvh_.nodes.emplace_back();
+        buildNode(0, 0, prims_.size(), 0);
+    }
+
+  private:
+    bool isSah() const {
+        return options_.builder == BvhBuilder::BinnedSah ||
+               options_.builder == BvhBuilder::SweepSah;
+    }
+
+    void buildNode(uint32_t nodeIndex, size_t begin, size_t end, int depth) {
+        Bounds3f bounds, centroids;
+        for (size_t i = begin; i < end; ++i) {
+            bounds.extend(prims_[i].bounds.min);
+            bounds.extend(prims_[i].bounds.max);
+            centroids.extend(prims_[i].centroid);
+        }
+        size_t n = end - begin;
+        BvhNode& node = bvh_.nodes[nodeIndex];
+        node.boundsMin = bounds.min;
+        node.boundsMax = bounds.max;
+        size_t leafLimit = size_t(std::max(1, isSah() ? options_.maxLeafSize : options_.leafSize));
+        auto makeLeaf = [&] {
+            BvhNode& leaf = bvh_.nodes[nodeIndex];
+            leaf.leftFirst = uint32_t(begin);
+            leaf.count = uint32_t(n);
+        };
+        // The depth cap ends any recursion, whatever the split rule does.
+        if (n == 1 || depth >= options_.maxDepth - 1) return makeLeaf();
+        if (!isSah() && n <= leafLimit) return makeLeaf();
+
+        std::span<BuildPrimitive> range(prims_.data() + begin, n);
+        size_t left = 0;
+        float splitCost = kInfinity<float>;
+        switch (options_.builder) {
+            case BvhBuilder::Midpoint:
+                left = partitionMidpoint(range, centroids);
+                break;
+            case BvhBuilder::Median:
+                left = partitionMedian(range, centroids);
+                break;
+            case BvhBuilder::BinnedSah:
+                left = partitionBinnedSah(range, bounds, centroids, options_, splitCost);
+                break;
+            case BvhBuilder::SweepSah:
+                left = partitionSweepSah(range, bounds, options_, splitCost);
+                break;
+        }
+        bool split = left > 0 && left < n;
+        if (isSah() && n <= leafLimit && !(splitCost < options_.intersectionCost * float(n)))
+            return makeLeaf();
+        if (!split) {
+            // No rule separates them (identical centroids, a line of primitives): a leaf if
+            // small enough, else halves in array order, which always terminates.
+            if (n <= leafLimit) return makeLeaf();
+            left = n / 2;
+        }
+        uint32_t leftChild = uint32_t(bvh_.nodes.size());
+        bvh_.nodes.emplace_back();
+        bvh_.nodes.emplace_back();
+        bvh_.nodes[nodeIndex].leftFirst = leftChild;
+        bvh_.nodes[nodeIndex].count = 0;
+        buildNode(leftChild, begin, begin + left, depth + 1);
+        buildNode(leftChild + 1, begin + left, end, depth + 1);
+    }
+
+    std::vector<BuildPrimitive>& prims_;
+    const BvhBuildOptions& options_;
+    Bvh& bvh_;
+};
+
+void checkOptions(const BvhBuildOptions& options) {
+    if (options.bins < 2 || options.bins > kMaxBins)
+        throw InputError("SAH bins must be between 2 and 256");
+    if (options.maxDepth < 1 || options.maxDepth > kTraversalStackSize / 2)
+        throw InputError("BVH depth limit must be between 1 and 64");
+}
+
+Bvh buildFromPrimitives(std::vector<BuildPrimitive>& prims, const BvhBuildOptions& options) {
+    checkOptions(options);
+    Bvh bvh;
+    BvhBuildJob(prims, options, bvh).build();
+    bvh.primitiveIndices.resize(prims.size());
+    for (size_t i = 0; i < prims.size(); ++i) bvh.primitiveIndices[i] = prims[i].index;
+    return bvh;
+}
+
+void finishStats(const Bvh& bvh, const BvhBuildOptions& options, double ms, BvhBuildStats* stats) {
+    if (!stats) return;
+    *stats = bvhStats(bvh, options);
+    stats->buildMs = ms;
+}
+
+}  // namespace
+
+Bvh buildBvh(std::span<const Bounds3f> primitiveBounds, const BvhBuildOptions& options,
+             BvhBuildStats* stats) {
+    Stopwatch watch;
+    std::vector<BuildPrimitive> prims(primitiveBounds.size());
+    for (size_t i = 0; i < prims.size(); ++i)
+        prims[i] = {primitiveBounds[i], primitiveBounds[i].centroid(), uint32_t(i)};
+    Bvh bvh = buildFromPrimitives(prims, options);
+    finishStats(bvh, options, watch.milliseconds(), stats);
+    return bvh;
+}
+
+Bvh buildBvh(const Mesh& mesh, const BvhBuildOptions& options, BvhBuildStats* stats) {
+    if (mesh.triangles.size() >= size_t(0xFFFFFFF0u))
+        throw InputError("mesh has too many triangles for 32-bit indices");
+    Stopwatch watch;
+    std::vector<BuildPrimitive> prims(mesh.triangles.size());
+    for (size_t i = 0; i < prims.size(); ++i) {
+        Bounds3f b;
+        for (int k = 0; k < 3; ++k) b.extend(mesh.vertex(i, k));
+        prims[i] = {b, b.centroid(), uint32_t(i)};
+    }
+    Bvh bvh = buildFromPrimitives(prims, options);
+    bvh.leafTriangles.resize(prims.size());
+    for (size_t s = 0; s < prims.size(); ++s) {
+        uint32_t t = bvh.primitiveIndices[s];
+        bvh.leafTriangles[s] = {mesh.vertex(t, 0), mesh.vertex(t, 1), mesh.vertex(t, 2)};
+    }
+    finishStats(bvh, options, watch.milliseconds(), stats);
+    return bvh;
+}
+
+double bvhSahCost(const Bvh& bvh, float traversalCost, float intersectionCost) {
+    if (bvh.empty()) return 0.0;
+    double rootArea = double(bvh.nodes[0].bounds().surfaceArea());
+    double cost = 0.0;
+    for (const BvhNode& node : bvh.nodes) {
+        // A tree without area (everything on a line) counts every node with weight 1.
+        double ratio = rootArea > 0.0 ? double(node.bounds().surfaceArea()) / rootArea : 1.0;
+        cost += node.isLeaf() ? double(intersectionCost) * node.count * ratio
+                              : double(traversalCost) * ratio;
+    }
+    return cost;
+}
+
+BvhBuildStats bvhStats(const Bvh& bvh, const BvhBuildOptions& options) {
+    BvhBuildStats s;
+    if (bvh.empty()) return s;
+    s.nodes = bvh.nodes.size();
+    s.minLeafSize = size_t(-1);
+    size_t leafPrims = 0;
+    std::vector<std::pair<uint32_t, int>> stack = {{0, 0}};
+    while (!stack.empty()) {
+        auto [index, depth] = stack.back();
+        stack.pop_back();
+        const BvhNode& node = bvh.nodes[index];
+        if (node.isLeaf()) {
+            ++s.leaves;
+            leafPrims += node.count;
+            s.minLeafSize = std::min(s.minLeafSize, size_t(node.count));
+            s.maxLeafSize = std::max(s.maxLeafSize, size_t(node.count));
+            s.depth = std::max(s.depth, depth);
+        } else {
+            stack.push_back({node.leftFirst, depth + 1});
+            stack.push_back({node.leftFirst + 1, depth + 1});
+        }
+    }
+    s.meanLeafSize = s.leaves ? double(leafPrims) / double(s.leaves) : 0.0;
+    s.sahCost = bvhSahCost(bvh, options.traversalCost, options.intersectionCost);
+    return s;
+}
+
+}  // namespace boxes

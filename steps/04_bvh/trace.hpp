@@ -1,0 +1,157 @@
+// Step 04: tracing triangle meshes through the hierarchy: the leaf test, the ray and hit
+// files of the `trace` command, batch tracing on threads, and brute force to check it.
+#pragma once
+
+#include <cstdint>
+#include <string>
+#include <vector>
+
+#include "04_bvh/bvh.hpp"
+#include "core/hit.hpp"
+#include "core/scene.hpp"
+
+namespace boxes {
+
+// The watertight ray/triangle test of Woop, Benthin and Wald (JCGT 2013), prepared once
+// per ray. This is a performance copy of step 01's exercise 1.5 (which stays the teaching
+// version): the permutation and shear are computed once per ray instead of per triangle,
+// and the arithmetic per triangle is otherwise the same, operation for operation, so the
+// two give bit-identical t. The hierarchy's hot loop calls this one, inlined.
+struct WatertightRay {
+    Vec3 origin;
+    int kx, ky, kz;
+    float sx, sy, sz;
+    float tmin;
+
+    explicit WatertightRay(const Ray& ray) : origin(ray.origin), tmin(ray.tmin) {
+        Vec3 absD = glm::abs(ray.direction);
+        kz = maxDimension(absD);
+        kx = (kz + 1) % 3;
+        ky = (kx + 1) % 3;
+        if ((&ray.direction.x)[kz] < 0.0f) std::swap(kx, ky);
+        const float* d = &ray.direction.x;
+        sx = d[kx] / d[kz];
+        sy = d[ky] / d[kz];
+        sz = 1.0f / d[kz];
+    }
+};
+
+// A hit in [ray.tmin, tmax] lowers tmax to it; (u, v) are the barycentrics of b and c.
+// Components are read through pointers: glm's operator[] is a switch, too slow here.
+inline bool intersectLeafTriangle(const WatertightRay& r, const LeafTriangle& tri, float& tmax,
+                                  float* uOut = nullptr, float* vOut = nullptr) {
+    const Vec3 av = tri.a - r.origin, bv = tri.b - r.origin, cv = tri.c - r.origin;
+    const float *a = &av.x, *b = &bv.x, *c = &cv.x;
+    float ax = a[r.kx] - r.sx * a[r.kz], ay = a[r.ky] - r.sy * a[r.kz];
+    float bx = b[r.kx] - r.sx * b[r.kz], by = b[r.ky] - r.sy * b[r.kz];
+    float cx = c[r.kx] - r.sx * c[r.kz], cy = c[r.ky] - r.sy * c[r.kz];
+    float u = cx * by - cy * bx;
+    float v = ax * cy - ay * cx;
+    float w = bx * ay - by * ax;
+    // Exactly zero: recompute in double so neighbours agree on the shared edge.
+    if (u == 0.0f || v == 0.0f || w == 0.0f) [[unlikely]] {
+        u = float(double(cx) * double(by) - double(cy) * double(bx));
+        v = float(double(ax) * double(cy) - double(ay) * double(cx));
+        w = float(double(bx) * double(ay) - double(by) * double(ax));
+    }
+    if ((u < 0.0f || v < 0.0f || w < 0.0f) && (u > 0.0f || v > 0.0f || w > 0.0f)) return false;
+    float det = u + v + w;
+    if (det == 0.0f || !std::isfinite(det)) return false;
+    float az = r.sz * a[r.kz], bz = r.sz * b[r.kz], cz = r.sz * c[r.kz];
+    float t = (u * az + v * bz + w * cz) / det;
+    if (!(t >= r.tmin && t <= tmax)) return false;
+    tmax = t;
+    if (uOut) *uOut = v / det;
+    if (vOut) *vOut = w / det;
+    return true;
+}
+
+// The nearest hit of one ray: t (+infinity on a miss) and the triangle in file order.
+struct TraceHit {
+    float t = kInfinity<float>;
+    uint32_t triangle = kNoPrimitive;
+    bool operator==(const TraceHit&) const = default;
+};
+static_assert(sizeof(TraceHit) == 8, "the HITS.bin record");
+
+inline TraceHit traceNearest(const Bvh& bvh, const Ray& ray) {
+    TraversalRay traversal(ray, bvh);
+    WatertightRay watertight(ray);
+    float tClosest = ray.tmax;
+    const LeafTriangle* tris = bvh.leafTriangles.data();
+    uint32_t slot = traverseNearest(bvh, traversal, tClosest, [&](uint32_t s, float& tmax) {
+        return intersectLeafTriangle(watertight, tris[s], tmax);
+    });
+    if (slot == kTraversalMiss) return {};
+    return {tClosest, bvh.primitiveIndices[slot]};
+}
+
+inline bool traceOccluded(const Bvh& bvh, const Ray& ray) {
+    TraversalRay traversal(ray, bvh);
+    WatertightRay watertight(ray);
+    const LeafTriangle* tris = bvh.leafTriangles.data();
+    return traverseAny(bvh, traversal, [&](uint32_t s, float tmax) {
+        return intersectLeafTriangle(watertight, tris[s], tmax);
+    });
+}
+
+// Every triangle, in file order; the first of equally near triangles wins.
+TraceHit traceBruteForce(const Mesh& mesh, const Ray& ray);
+
+// RAYS.bin: float32 ox oy oz tmin dx dy dz tmax per ray (little-endian).
+struct RayRecord {
+    float origin[3];
+    float tmin;
+    float direction[3];
+    float tmax;
+};
+static_assert(sizeof(RayRecord) == 32, "the RAYS.bin record");
+
+// Reads and checks a rays file: size a multiple of 32 bytes, finite origins and
+// directions, non-zero directions, no NaN in tmin/tmax. Throws InputError naming the
+// file and the first bad ray.
+std::vector<Ray> readRays(const std::string& path);
+void writeRays(const std::string& path, const std::vector<Ray>& rays);
+// HITS.bin: float32 t, uint32 triangle per ray; written atomically (temp file + rename).
+void writeHits(const std::string& path, const std::vector<TraceHit>& hits);
+std::vector<TraceHit> readHits(const std::string& path);
+
+// Traces every ray on `threads` threads (chunks handed out dynamically).
+void traceBatch(const Bvh& bvh, const std::vector<Ray>& rays, std::vector<TraceHit>& hits,
+                int threads);
+void traceBatchBruteForce(const Mesh& mesh, const std::vector<Ray>& rays,
+                          std::vector<TraceHit>& hits, int threads);
+
+// Does a hierarchy's hit agree with brute force: the same triangle, or the same t (two
+// triangles sharing the hit point)?
+inline bool hitsAgree(const TraceHit& a, const TraceHit& b) {
+    return a.triangle == b.triangle || a.t == b.t;
+}
+
+// Ray sets like peer-bench's make_rays.py (for tests and the measure run): primary rays of
+// a camera framing the mesh, diffuse rays from points on its surface, random rays in its
+// inflated bounds.
+enum class RayKind { Primary, Diffuse, Random };
+const char* rayKindName(RayKind kind);
+std::vector<Ray> makeRays(const Mesh& mesh, RayKind kind, size_t count, uint64_t seed);
+
+// The mesh as renderer geometry, through the hierarchy.
+class MeshBvhGeometry : public Geometry {
+public:
+    MeshBvhGeometry(const Mesh& mesh, int material, const BvhBuildOptions& options);
+    bool intersect(const Ray& ray, SurfaceHit& hit) const override;
+    bool occluded(const Ray& ray) const override;
+    Vec3 boundsMin() const override { return bvh_.bounds().min; }
+    Vec3 boundsMax() const override { return bvh_.bounds().max; }
+    std::vector<int> materialsUsed() const override { return {material_}; }
+    const Bvh& bvh() const { return bvh_; }
+    const BvhBuildStats& stats() const { return stats_; }
+
+private:
+    const Mesh& mesh_;
+    int material_;
+    Bvh bvh_;
+    BvhBuildStats stats_;
+};
+
+}  // namespace boxes

@@ -1,0 +1,354 @@
+// Step 05: efficiency. The optimization lab (--measure prints every trade-off as time
+// against error) and perceived performance in the window: previews while the camera
+// moves, line-by-line refinement within a frame budget when it stops, a photograph mode.
+#include <SDL2/SDL_keycode.h>
+#include <imgui.h>
+
+#include <cstdio>
+#include <iostream>
+#include <memory>
+
+#include "01_triangle/triangle_grid.hpp"
+#include "05_efficiency/measure.hpp"
+#include "05_efficiency/progressive.hpp"
+#include "core/app.hpp"
+#include "core/orbit.hpp"
+#include "core/render.hpp"
+#include "core/timing.hpp"
+
+using namespace boxes;
+
+namespace {
+
+std::string withSuffix(const std::string& png, const std::string& suffix) {
+    std::string stem =
+        png.size() > 4 && png.ends_with(".png") ? png.substr(0, png.size() - 4) : png;
+    return stem + suffix + ".png";
+}
+
+std::string slug(PreviewMode m) {
+    switch (m) {
+        case PreviewMode::Depth:
+            return "depth";
+        case PreviewMode::DepthMaterial:
+            return "depth-material";
+        case PreviewMode::NoRecursion:
+            return "no-recursion";
+        case PreviewMode::LimitedRecursion:
+            return "limited-recursion";
+        case PreviewMode::HalfResolution:
+            return "half-resolution";
+        case PreviewMode::Adaptive:
+            return "adaptive";
+        default:
+            return "full";
+    }
+}
+
+// What the optimizations bought on this scene: the naive renderer (every effect traced,
+// lights without a radius, one thread) against the optimized one, step by step.
+Table totalSpeedup(const Scene& scene, int repeats) {
+    Table t;
+    t.id = "total";
+    t.title = "All together on the scene: time per frame as each optimization is switched on";
+    t.columns = {"variant", "ms/frame", "min ms", "max ms", "ratio to naive"};
+    t.note = "scene '" + scene.name +
+             "', 160x120, max depth 5, median of repeats; the mesh optimizations "
+             "(precomputed data, early out) are in the precalc table";
+    Scene infinite = scene;
+    for (auto& l : infinite.lights) l.radius = kInfinity<float>;
+    struct Variant {
+        const char* name;
+        const Scene* scene;
+        bool force;
+        int threads;
+    };
+    double base = 0.0;
+    for (const Variant& v : {Variant{"naive: every effect forced, infinite light radius, 1 thread",
+                                     &infinite, true, 1},
+                             Variant{"+ effects on demand", &infinite, false, 1},
+                             Variant{"+ finite light radius", &scene, false, 1},
+                             Variant{"+ all threads", &scene, false, 0}}) {
+        RenderSettings s;
+        s.width = 160;
+        s.height = 120;
+        s.threads = v.threads;
+        s.forceAllEffects = v.force;
+        Renderer r(*v.scene, v.scene->camera, s);
+        Timing tm = measure(repeats, [&] { keepValue(r.render()); });
+        if (base == 0.0) base = tm.median;
+        t.row({std::string(v.name), tm.median * 1e3, tm.min * 1e3, tm.max * 1e3, base / tm.median});
+    }
+    return t;
+}
+
+}  // namespace
+
+int main(int argc, char** argv) {
+    return runMain("05_efficiency", [&] {
+        CLI::App app{
+            "Step 05: efficiency: the optimization lab as accuracy-against-time tables, effects on "
+            "demand, and perceived performance (previews, refinement, photograph mode)."};
+        CommonOptions opts;
+        addCommonOptions(app, opts, "spheres");
+        bool measure = false;
+        app.add_flag("--measure", measure, "also run the lab and print its tables");
+        int repeats = 5;
+        app.add_option("--repeats", repeats, "timed repeats per variant in the lab")
+            ->check(CLI::Range(1, 101))
+            ->capture_default_str();
+        double budgetMs = 15.0;
+        app.add_option("--budget-ms", budgetMs, "refinement time budget per frame (window)")
+            ->check(CLI::Range(1.0, 1000.0))
+            ->capture_default_str();
+        int photoSpp = 16, photoDepth = 12;
+        app.add_option("--photo-spp", photoSpp, "photograph mode: samples per pixel")
+            ->check(CLI::Range(1, 1024))
+            ->capture_default_str();
+        app.add_option("--photo-depth", photoDepth, "photograph mode: maximum recursion depth")
+            ->check(CLI::Range(0, 64))
+            ->capture_default_str();
+        parseCommandLine(app, argc, argv);
+
+        Scene scene = sceneFromOptions(opts);
+        if (scene.hasMesh())
+            scene.geometries.push_back(
+                std::make_shared<TriangleGrid>(scene.mesh, scene.meshMaterial));
+        Camera camera = cameraFromOptions(opts, scene.camera);
+        scene.camera = camera;
+        RenderSettings settings;
+        settings.width = opts.width;
+        settings.height = opts.height;
+        settings.threads = opts.threads;
+        settings.seed = opts.seed;
+
+        if (opts.headless) {
+            Report report;
+            report.program = "05_efficiency";
+            std::string out = opts.out.empty() ? "05_efficiency.png" : opts.out;
+            RenderSettings full = settings;
+            full.progressLabel = "05_efficiency: rendering";
+            Stopwatch watch;
+            RayCounts counts;
+            Image image = renderImage(scene, camera, full, &counts);
+            double seconds = watch.seconds();
+            // The same image line by line, as the window refines it: must be bit-identical.
+            Renderer renderer(scene, camera, settings);
+            RayCounts lineCounts;
+            IncrementalRenderer incremental(
+                settings.width, settings.height,
+                [&](Image& img, int row) { renderer.renderRows(img, row, row + 1, lineCounts); },
+                steadyClock());
+            int frames = 0;
+            while (!incremental.complete()) incremental.advance(budgetMs * 1e-3), ++frames;
+            bool identical = compareImages(incremental.image(), image).maxError == 0.0;
+            image.writePng(out);
+            report.images.push_back({out, "scene '" + scene.name + "', full render"});
+            for (PreviewMode m : kAllPreviewModes) {
+                if (m == PreviewMode::Full) continue;
+                std::string path = withSuffix(out, "-" + slug(m));
+                renderPreview(scene, camera, m, settings, 0.25f).writePng(path);
+                report.images.push_back({path, std::string("preview: ") + previewModeName(m)});
+            }
+            report.facts["render_ms"] = seconds * 1e3;
+            report.facts["rays"] = counts.total();
+            report.facts["refinement_frames"] = frames;
+            report.facts["refinement_budget_ms"] = budgetMs;
+            report.facts["refined_image_bit_identical"] = identical;
+            std::cerr << "05_efficiency: wrote " << out << " and " << report.images.size() - 1
+                      << " previews (" << image.width() << "x" << image.height() << ", "
+                      << formatSeconds(seconds) << "; refined in " << frames << " frames of "
+                      << budgetMs << " ms, " << (identical ? "bit-identical" : "NOT identical")
+                      << ")\n";
+            if (!identical)
+                throw std::runtime_error("the refined image differs from the direct render");
+            if (measure) {
+                LabOptions lab;
+                lab.repeats = repeats;
+                lab.threads = opts.threads;
+                lab.seed = opts.seed;
+                lab.dataDir = opts.dataDir;
+                Mesh bunny =
+                    scene.hasMesh() ? scene.mesh : loadObj(opts.dataDir + "/meshes/bunny.obj");
+                auto step = [&](const char* what, auto&& f) {
+                    std::cerr << "05_efficiency: " << what << "...\n";
+                    report.add(f());
+                };
+                step("measuring the measurement", [&] { return measureMeasuring(lab); });
+                step("float against double", [&] { return measureFloatDouble(lab); });
+                step("acne", [&] { return measureAcne(lab); });
+                step("sine tables", [&] { return measureSinCos(lab); });
+                step("early out", [&] { return measureEarlyOut(bunny, lab); });
+                step("finite light radius", [&] { return measureLightRadius(lab); });
+                step("effects on demand", [&] { return measureEffects(lab); });
+                step("precalculation", [&] { return measurePrecalculation(bunny, lab); });
+                step("expensive operations", [&] { return measureExpensiveOps(lab); });
+                step("reciprocal square root", [&] { return measureInverseSqrt(lab); });
+                step("threads", [&] { return measureThreads(scene, lab); });
+                step("anti-aliasing", [&] { return measureAntiAliasing(scene, lab); });
+                step("previews", [&] { return measurePreviews(scene, lab); });
+                step("all together", [&] { return totalSpeedup(scene, repeats); });
+                const Table& total = report.tables.back();
+                report.facts["total_speedup"] = std::get<double>(total.rows.back().back());
+                auto plot = [&](const char* table, const char* x, const char* y, const char* series,
+                                const char* title, bool logx, bool logy) {
+                    report.plots.push_back({{"table", table},
+                                            {"x", x},
+                                            {"y", y},
+                                            {"series", series},
+                                            {"title", title},
+                                            {"logx", logx},
+                                            {"logy", logy}});
+                };
+                plot("float_double", "ns/test", "max rel t error", "variant",
+                     "Float against double: time per test and the largest relative error in t",
+                     false, true);
+                plot("sincos", "ns/call", "max abs error", "variant",
+                     "Sine: time per call against the largest error over the circle", false, true);
+                plot("antialiasing", "ms/frame", "RMSE", "samples/pixel",
+                     "Anti-aliasing: error against time for 1, 4, 16, 64 samples per pixel", true,
+                     true);
+                plot("threads", "threads", "speed-up", "schedule",
+                     "Threads: speed-up over one thread", false, false);
+                plot("precalc", "ms/frame", "triangle tests/pixel", "variant",
+                     "Precalculation and early out: time per frame against the work per pixel",
+                     false, true);
+                plot("rsqrt", "ns/call", "max relative error", "variant",
+                     "Reciprocal square root: time against error", false, true);
+                plot("previews", "ms/frame", "RMSE against full", "mode",
+                     "Preview modes: time per frame against the error of the preview", true, false);
+            }
+            report.write(opts.json ? std::cerr : std::cout, opts.json ? "-" : opts.reportPath);
+            if (opts.json && !opts.reportPath.empty()) report.write(std::cerr, opts.reportPath);
+            return 0;
+        }
+
+        // ---- The window ---------------------------------------------------------------
+        OrbitController orbit(camera);
+        PreviewMode mode = PreviewMode::Adaptive;
+        AdaptiveResolution adaptive(1.0 / 30.0);
+        bool moved = true;
+        Image preview;
+        double previewMs = 0.0;
+        std::unique_ptr<Renderer> refiner;  // full recursion, for the current camera
+        Clock clock = steadyClock();
+        IncrementalRenderer refinement(
+            settings.width, settings.height,
+            [&](Image& img, int row) {
+                RayCounts c;
+                refiner->renderRows(img, row, row + 1, c);
+            },
+            clock);
+        // Photograph mode: deep recursion and stratified samples, also line by line.
+        std::unique_ptr<Renderer> photographer;
+        std::unique_ptr<IncrementalRenderer> photo;
+        Image photoShown;
+        int photoIndex = 0;
+        std::string photoMessage;
+        const double photoBudget = 0.03;
+
+        WindowCallbacks cb;
+        cb.keys = {{SDLK_1, "preview while moving: depth map"},
+                   {SDLK_2, "preview: depth + material colour"},
+                   {SDLK_3, "preview: no recursion"},
+                   {SDLK_4, "preview: limited recursion (1 bounce)"},
+                   {SDLK_5, "preview: half resolution"},
+                   {SDLK_6, "preview: adaptive resolution (30 fps target)"},
+                   {SDLK_0, "preview: full render every frame"},
+                   {SDLK_p, "photograph: deep recursion, anti-aliasing, saves a PNG"},
+                   {SDLK_ESCAPE, "cancel the photograph (quits when none runs)"}};
+        for (const KeyBinding& k : OrbitController::keys()) cb.keys.push_back(k);
+        cb.onKey = [&](int key) {
+            if (photo && key == SDLK_ESCAPE) {
+                photo.reset();
+                photoShown = Image();
+                photoMessage = "photograph cancelled";
+                std::cout << "05_efficiency: photograph cancelled" << std::endl;
+                return true;
+            }
+            const std::pair<int, PreviewMode> modes[] = {{SDLK_1, PreviewMode::Depth},
+                                                         {SDLK_2, PreviewMode::DepthMaterial},
+                                                         {SDLK_3, PreviewMode::NoRecursion},
+                                                         {SDLK_4, PreviewMode::LimitedRecursion},
+                                                         {SDLK_5, PreviewMode::HalfResolution},
+                                                         {SDLK_6, PreviewMode::Adaptive},
+                                                         {SDLK_0, PreviewMode::Full}};
+            for (auto [k, m] : modes)
+                if (key == k) {
+                    mode = m;
+                    moved = true;
+                    return true;
+                }
+            if (key == SDLK_p) {
+                RenderSettings ps = settings;
+                ps.samplesPerPixel = photoSpp;
+                ps.maxDepth = photoDepth;
+                photographer = std::make_unique<Renderer>(scene, orbit.camera(), ps);
+                photo = std::make_unique<IncrementalRenderer>(
+                    settings.width, settings.height,
+                    [&](Image& img, int row) {
+                        RayCounts c;
+                        photographer->renderRows(img, row, row + 1, c);
+                    },
+                    clock);
+                photo->restart(refinement.image());
+                photoMessage.clear();
+                return true;
+            }
+            if (orbit.onKey(key)) {
+                photoShown = Image();
+                return moved = true;
+            }
+            return false;
+        };
+        cb.onMouseDrag = [&](float dx, float dy) {
+            orbit.onDrag(dx, dy);
+            photoShown = Image();
+            moved = true;
+        };
+        cb.frame = [&](double) -> const Image& {
+            if (photo) {
+                photo->advance(photoBudget);
+                if (!photo->complete()) return photo->image();
+                std::string path = "05_efficiency-photo-" + std::to_string(++photoIndex) + ".png";
+                photo->image().writePng(path);
+                std::cout << "05_efficiency: photograph saved to " << path << std::endl;
+                photoMessage = "saved " + path;
+                photoShown = photo->image();
+                photo.reset();
+            }
+            if (!photoShown.empty()) return photoShown;
+            if (moved) {
+                Stopwatch watch;
+                preview = renderPreview(scene, orbit.camera(), mode, settings, adaptive.scale());
+                previewMs = watch.milliseconds();
+                if (mode == PreviewMode::Adaptive) adaptive.update(previewMs * 1e-3);
+                refiner = std::make_unique<Renderer>(scene, orbit.camera(), settings);
+                refinement.restart(preview);
+                moved = false;
+                return refinement.image();
+            }
+            // Stationary: refine with full recursion, at most the budget per frame.
+            if (!refinement.complete()) refinement.advance(budgetMs * 1e-3);
+            return refinement.image();
+        };
+        cb.panel = [&] {
+            ImGui::Text("preview: %s (%.1f ms)", previewModeName(mode), previewMs);
+            if (mode == PreviewMode::Adaptive)
+                ImGui::Text("adaptive scale: %.2f", adaptive.scale());
+            if (photo) {
+                ImGui::Text("photograph: %d spp, depth %d (Esc cancels)", photoSpp, photoDepth);
+                ImGui::ProgressBar(float(photo->progress()));
+            } else if (refinement.complete()) {
+                ImGui::Text("refined: complete (full recursion)");
+            } else {
+                ImGui::Text("refining: line %d of %d, %.0f ms budget per frame",
+                            refinement.linesDone(), settings.height, budgetMs);
+                ImGui::ProgressBar(float(refinement.progress()));
+            }
+            if (!photoMessage.empty()) ImGui::TextUnformatted(photoMessage.c_str());
+        };
+        runWindow(opts.windowOptions("Step 05: efficiency"), cb);
+        return 0;
+    });
+}

@@ -1,0 +1,353 @@
+// Step 02: boxes as six planes and as slabs, with hand-worked numbers, the hard cases by
+// name, the erratum's sign error, and the program.
+#include <cmath>
+#include <random>
+
+#include "02_box/box.hpp"
+#include "02_box/box_scene.hpp"
+#include "core/render.hpp"
+#include "support.hpp"
+
+using namespace boxes;
+using boxes::test::checkVec;
+
+namespace {
+
+const double s2 = 1.0 / std::sqrt(2.0);
+
+// The unit cube [-1, 1]^3 and the same cube turned 45 degrees about z: in the xy plane a
+// diamond |x| + |y| <= sqrt(2).
+OrientedBoxd unitCube() {
+    return OrientedBoxd{};
+}
+OrientedBoxd diamond() {
+    return OrientedBoxd{
+        {0, 0, 0}, {Vec3d(s2, s2, 0), Vec3d(-s2, s2, 0), Vec3d(0, 0, 1)}, {1, 1, 1}};
+}
+
+// Test-local face planes (exercise 2.1 is not needed by 2.2's tests).
+template <typename T>
+std::array<PlaneT<T>, 6> planesOf(const OrientedBoxT<T>& box) {
+    std::array<PlaneT<T>, 6> p;
+    for (int f = 0; f < 6; ++f) {
+        Vec3T<T> n = (f % 2 ? T(1) : T(-1)) * box.axes[size_t(f / 2)];
+        p[size_t(f)] = {n, -(glm::dot(n, box.centre) + box.halfExtents[f / 2])};
+    }
+    return p;
+}
+
+// Both full methods behind one call, so the same worked numbers check each.
+template <typename T>
+std::optional<BoxHit<T>> hitWith(BoxMethod m, const RayT<T>& ray, const OrientedBoxT<T>& box) {
+    return m == BoxMethod::SixPlanes ? intersectSixPlanes(ray, planesOf(box))
+                                     : intersectBoxSlabs(ray, box);
+}
+
+void checkWorkedBoxHits(BoxMethod m) {
+    INFO(boxMethodName(m));
+    // From (-3, 0.5, 0) along +x into the unit cube: t = 2 through face 0 (-x), entering.
+    auto h = hitWith(m, Rayd({-3, 0.5, 0}, {1, 0, 0}), unitCube());
+    REQUIRE(h.has_value());
+    CHECK(h->t == doctest::Approx(2.0));
+    CHECK(h->face == 0);
+    checkVec(h->normal, Vec3d(-1, 0, 0), 1e-15);
+    CHECK(h->entering);
+    // The diamond at y = 0.5 begins at x = -(sqrt(2) - 0.5): t = 5.5 - sqrt(2), through
+    // face 3 (+a1), whose normal is (-1, 1, 0)/sqrt(2).
+    auto g = hitWith(m, Rayd({-5, 0.5, 0}, {1, 0, 0}), diamond());
+    REQUIRE(g.has_value());
+    CHECK(g->t == doctest::Approx(5.5 - std::sqrt(2.0)));
+    CHECK(g->face == 3);
+    checkVec(g->normal, Vec3d(-s2, s2, 0), 1e-12);
+    CHECK(g->entering);
+    // A miss beside the diamond (|x| + |y| > sqrt(2) everywhere on the line y = 1.5).
+    CHECK_FALSE(hitWith(m, Rayd({-5, 1.5, 0}, {1, 0, 0}), diamond()));
+    // A direction that is not unit length scales t: D = (4, 0, 0) reaches face 0 at t = 0.5.
+    auto s = hitWith(m, Rayd({-3, 0, 0}, {4, 0, 0}), unitCube());
+    REQUIRE(s.has_value());
+    CHECK(s->t == doctest::Approx(0.5));
+    // Float too.
+    OrientedBox cube;
+    auto f = m == BoxMethod::SixPlanes
+                 ? intersectSixPlanes(Ray({0.2f, 5, 0.3f}, {0, -1, 0}), planesOf(cube))
+                 : intersectBoxSlabs(Ray({0.2f, 5, 0.3f}, {0, -1, 0}), cube);
+    REQUIRE(f.has_value());
+    CHECK(f->t == 4.0f);
+    CHECK(f->face == 3);
+}
+
+void checkBoxHardCases(BoxMethod m) {
+    INFO(boxMethodName(m));
+    SUBCASE("hard case: origin inside the box reports the exit face") {
+        auto h = hitWith(m, Rayd({0, 0, 0}, {1, 0, 0}), unitCube());
+        REQUIRE(h.has_value());
+        CHECK(h->t == doctest::Approx(1.0));
+        CHECK(h->face == 1);
+        checkVec(h->normal, Vec3d(1, 0, 0), 1e-15);
+        CHECK_FALSE(h->entering);
+        // In the diamond, from the centre along +x the exit is the corner at x = sqrt(2);
+        // along (1, 1, 0) it is face 1 (+a0) at t = 1/sqrt(2) * ... = 1/sqrt(2) per unit of
+        // (1,1,0): a0.(t, t, 0) = sqrt(2) t = 1.
+        auto g = hitWith(m, Rayd({0, 0, 0}, {1, 1, 0}), diamond());
+        REQUIRE(g.has_value());
+        CHECK(g->t == doctest::Approx(s2));
+        CHECK(g->face == 1);
+        CHECK_FALSE(g->entering);
+    }
+    SUBCASE("hard case: the segment entirely inside the box hits nothing") {
+        CHECK_FALSE(hitWith(m, Rayd({0, 0, 0}, {1, 0, 0}, 0.0, 0.5), unitCube()));
+    }
+    SUBCASE("hard case: a box behind the ray is missed") {
+        CHECK_FALSE(hitWith(m, Rayd({3, 0, 0}, {1, 0, 0}), unitCube()));
+        CHECK_FALSE(hitWith(m, Rayd({0, -4, 0}, {0, -1, 0}), diamond()));
+    }
+    SUBCASE("hard case: a hit beyond tmax is missed and one at tmax counts") {
+        CHECK_FALSE(hitWith(m, Rayd({-3, 0, 0}, {1, 0, 0}, 0.0, 1.5), unitCube()));
+        CHECK(hitWith(m, Rayd({-3, 0, 0}, {1, 0, 0}, 0.0, 2.0), unitCube()));
+    }
+    SUBCASE("hard case: direction components +0.0 and -0.0 (parallel to faces)") {
+        for (double zero : {0.0, -0.0}) {
+            auto h = hitWith(m, Rayd({-3, 0.5, 0.25}, {1, zero, zero}), unitCube());
+            REQUIRE(h.has_value());
+            CHECK(h->t == doctest::Approx(2.0));
+            CHECK(h->face == 0);
+            // Parallel and outside the y slab: a miss.
+            CHECK_FALSE(hitWith(m, Rayd({-3, 1.5, 0}, {1, zero, zero}), unitCube()));
+            auto f = m == BoxMethod::SixPlanes
+                         ? intersectSixPlanes(Ray({-3, 0.5f, 0}, {1, float(zero), float(zero)}),
+                                              planesOf(OrientedBox{}))
+                         : intersectBoxSlabs(Ray({-3, 0.5f, 0}, {1, float(zero), float(zero)}),
+                                             OrientedBox{});
+            CHECK(f.has_value());
+        }
+    }
+    SUBCASE("hard case: touching a face plane along it counts (closed box)") {
+        // A ray in the plane y = 1 of the top face enters through face 0 at t = 2.
+        auto h = hitWith(m, Rayd({-3, 1, 0}, {1, 0, 0}), unitCube());
+        REQUIRE(h.has_value());
+        CHECK(h->t == doctest::Approx(2.0));
+        // Through the edge x = -1, y = 1 from the diagonal direction.
+        auto e = hitWith(m, Rayd({-2, 2, 0}, {1, -1, 0}), unitCube());
+        REQUIRE(e.has_value());
+        CHECK(e->t == doctest::Approx(1.0));
+    }
+}
+
+}  // namespace
+
+TEST_SUITE("exercise 2.1") {
+    TEST_CASE("face planes of an axis-aligned and a rotated box") {
+        OrientedBoxd b =
+            OrientedBoxd::axisAligned(Bounds3d({0, 0, 0}, {2, 4, 6}));  // centre (1,2,3)
+        auto p = boxFacePlanes(b);
+        // +x: x = 2, so N = (1,0,0), d = -2; -z: z = 0, N = (0,0,-1), d = 0; -y: y = 0.
+        checkVec(p[1].normal, Vec3d(1, 0, 0), 1e-15);
+        CHECK(p[1].d == doctest::Approx(-2.0));
+        checkVec(p[4].normal, Vec3d(0, 0, -1), 1e-15);
+        CHECK(p[4].d == doctest::Approx(0.0));
+        checkVec(p[2].normal, Vec3d(0, -1, 0), 1e-15);
+        CHECK(p[2].d == doctest::Approx(0.0));
+        checkVec(p[5].normal, Vec3d(0, 0, 1), 1e-15);
+        CHECK(p[5].d == doctest::Approx(-6.0));
+        // The diamond: face 3 is N = (-1,1,0)/sqrt(2) at distance 1 from the origin.
+        auto q = boxFacePlanes(diamond());
+        checkVec(q[3].normal, Vec3d(-s2, s2, 0), 1e-15);
+        CHECK(q[3].d == doctest::Approx(-1.0));
+        // Every corner lies on three planes and inside all six.
+        for (int f = 0; f < 6; ++f) {
+            Vec3d corner(1, 1, 1);
+            double v =
+                glm::dot(p[size_t(f)].normal, Vec3d(2, 4, 6) * 0.5 + corner * Vec3d(1, 2, 3)) +
+                p[size_t(f)].d;
+            CHECK(v <= 1e-12);
+        }
+    }
+}
+
+TEST_SUITE("exercise 2.2") {
+    TEST_CASE("six planes: worked hits") {
+        checkWorkedBoxHits(BoxMethod::SixPlanes);
+    }
+    TEST_CASE("six planes: hard cases") {
+        checkBoxHardCases(BoxMethod::SixPlanes);
+    }
+}
+
+TEST_SUITE("exercise 2.3") {
+    TEST_CASE("axis-aligned plane distance: worked values") {
+        CHECK(axisPlaneDistance(2.0, 0.0, 1.0) == 2.0);
+        CHECK(axisPlaneDistance(4.0, 1.0, 0.5) == 6.0);
+        CHECK(axisPlaneDistance(-1.0, 3.0, -2.0) == 2.0);     // moving towards -x
+        CHECK(axisPlaneDistance(1.0f, 3.0f, 2.0f) == -1.0f);  // behind: negative
+    }
+    TEST_CASE("hard case: zero direction component gives infinities or NaN") {
+        CHECK(axisPlaneDistance(2.0, 0.0, 0.0) == kInfinity<double>);
+        CHECK(axisPlaneDistance(2.0, 0.0, -0.0) == -kInfinity<double>);
+        CHECK(std::isnan(axisPlaneDistance(2.0, 2.0, 0.0)));  // origin in the plane: 0/0
+    }
+    TEST_CASE("hard case: the erratum's sign error mirrors every distance") {
+        // The known ray O = (0,0,0), D = (1,0,0) and the slab 2 <= x <= 4 in front of it.
+        double near = axisPlaneDistance(2.0, 0.0, 1.0), far = axisPlaneDistance(4.0, 0.0, 1.0);
+        CHECK(near == 2.0);
+        CHECK(far == 4.0);
+        // With t = (O_x - x_plane)/D_x the slab seems to lie at t in [-4, -2]: behind the
+        // ray, so the box in front is missed...
+        double wrongNear = axisPlaneDistanceSignError(2.0, 0.0, 1.0);
+        double wrongFar = axisPlaneDistanceSignError(4.0, 0.0, 1.0);
+        CHECK(wrongNear == -2.0);
+        CHECK(wrongFar == -4.0);
+        CHECK(std::max(wrongNear, wrongFar) < 0.0);
+        // ...and the slab -4 <= x <= -2 behind the ray seems to lie at t in [2, 4]: hit.
+        CHECK(axisPlaneDistanceSignError(-2.0, 0.0, 1.0) == 2.0);
+        CHECK(axisPlaneDistanceSignError(-4.0, 0.0, 1.0) == 4.0);
+        CHECK(axisPlaneDistance(-2.0, 0.0, 1.0) == -2.0);
+    }
+}
+
+TEST_SUITE("exercise 2.4") {
+    TEST_CASE("slabs: worked hits") {
+        checkWorkedBoxHits(BoxMethod::Slabs);
+    }
+    TEST_CASE("slabs: hard cases") {
+        checkBoxHardCases(BoxMethod::Slabs);
+    }
+    TEST_CASE("hard case: a flat box of zero thickness is hit") {
+        OrientedBoxd flat{{0, 0, 0}, {Vec3d(1, 0, 0), Vec3d(0, 1, 0), Vec3d(0, 0, 1)}, {1, 0, 1}};
+        auto h = intersectBoxSlabs(Rayd({0.5, 3, 0.5}, {0, -1, 0}), flat);
+        REQUIRE(h.has_value());
+        CHECK(h->t == 3.0);
+        CHECK(h->face == 3);
+        CHECK(h->entering);
+    }
+    TEST_CASE("slabs agree with a double reference on random rotated boxes") {
+        // The reference: marching along the ray and testing containment in the box's frame.
+        std::mt19937_64 rng(3);
+        std::uniform_real_distribution<double> u(-1.0, 1.0);
+        int hits = 0;
+        for (int i = 0; i < 2000; ++i) {
+            OrientedBoxd box = OrientedBoxd::rotated({u(rng), u(rng), u(rng)},
+                                                     {0.3 + 0.5 * (u(rng) + 1), 0.4, 0.7},
+                                                     {u(rng), u(rng), u(rng) + 2.0}, 3.0 * u(rng));
+            Vec3d origin(4 * u(rng), 4 * u(rng), 4 * u(rng));
+            Rayd ray(origin, box.centre - origin + 0.7 * Vec3d(u(rng), u(rng), u(rng)));
+            auto a = intersectBoxSlabs(ray, box);
+            // Brute force: march along the ray and test containment, to within the step.
+            bool inside0 = false;
+            double firstInside = -1;
+            for (int k = 0; k <= 4000; ++k) {
+                double t = k * 0.004;
+                Vec3d p = ray.at(t) - box.centre;
+                bool in = true;
+                for (int ax = 0; ax < 3; ++ax)
+                    in = in && std::abs(glm::dot(p, box.axes[size_t(ax)])) <= box.halfExtents[ax];
+                if (k == 0) inside0 = in;
+                if (in && firstInside < 0 && !inside0) firstInside = t;
+            }
+            if (!inside0 && firstInside >= 0) {
+                INFO("ray " << i);
+                REQUIRE(a.has_value());
+                CHECK(a->t <= firstInside + 1e-12);
+                CHECK(a->t >= firstInside - 0.004 - 1e-12);
+                CHECK(a->entering);
+                ++hits;
+            }
+        }
+        CHECK(hits > 100);
+    }
+}
+
+TEST_SUITE("hard cases 02") {
+    TEST_CASE("bad input: invalid boxes are refused with a clear error") {
+        OrientedBox negative;
+        negative.halfExtents = Vec3(1, -1, 1);
+        CHECK_THROWS_WITH_AS(negative.validate(), doctest::Contains("negative"),
+                             std::invalid_argument);
+        OrientedBox nan;
+        nan.centre.x = std::nanf("");
+        CHECK_THROWS_WITH_AS(nan.validate(), doctest::Contains("not finite"),
+                             std::invalid_argument);
+        OrientedBox skew;
+        skew.axes[1] = glm::normalize(Vec3(1, 1, 0));
+        CHECK_THROWS_WITH_AS(skew.validate(), doctest::Contains("orthogonal"),
+                             std::invalid_argument);
+        CHECK_THROWS_AS(BoxSet({{negative, 0}}), std::invalid_argument);
+        CHECK_THROWS_AS(Ray(Vec3(0), Vec3(0)), std::invalid_argument);  // zero direction
+    }
+}
+
+TEST_SUITE("program 02") {
+    const std::string program = BOXES_PROGRAM;
+
+    TEST_CASE("the box scene renders the same image with both methods") {
+        Scene a = makeBoxScene(4.0f / 3.0f), b = a;
+        a.geometries.push_back(std::make_shared<BoxSet>(boxStepBoxes(), BoxMethod::SixPlanes));
+        b.geometries.push_back(std::make_shared<BoxSet>(boxStepBoxes(), BoxMethod::Slabs));
+        RenderSettings s;
+        s.width = 64;
+        s.height = 48;
+        ImageDifference d =
+            compareImages(renderImage(a, a.camera, s), renderImage(b, b.camera, s), 1.0f / 255.0f);
+        CHECK(d.pixelsDiffering <= 2);  // at most a pixel on an edge
+    }
+    TEST_CASE("headless render writes a PNG of the requested size") {
+        test::TempDir dir;
+        auto run = test::runProgram(
+            program, "--headless --width 64 --height 40 --out a.png --method planes", dir);
+        INFO(run.err);
+        REQUIRE(run.exitCode == 0);
+        CHECK(test::pngSize(dir.file("a.png")) == std::pair{64, 40});
+    }
+    TEST_CASE("a core scene drawn as boxes") {
+        test::TempDir dir;
+        auto run = test::runProgram(
+            program, "--headless --scene sh1 --width 32 --height 24 --out s.png", dir);
+        INFO(run.err);
+        REQUIRE(run.exitCode == 0);
+        CHECK(test::pngSize(dir.file("s.png")) == std::pair{32, 24});
+    }
+    TEST_CASE("measurements: the JSON report has the speed and disagreement tables") {
+        test::TempDir dir;
+        auto run = test::runProgram(program,
+                                    "--headless --width 32 --height 24 --out a.png --measure "
+                                    "--rays-per-box 20 --report r.json",
+                                    dir);
+        INFO(run.err);
+        REQUIRE(run.exitCode == 0);
+        std::string json = test::readText(dir.file("r.json"));
+        for (const char* id : {"\"box_speed\"", "\"box_accuracy\"", "\"method_disagreement\""}) {
+            INFO(id);
+            CHECK(json.find(id) != std::string::npos);
+        }
+        CHECK(test::pngSize(dir.file("a-disagree.png")) == std::pair{32, 24});
+        CHECK(run.out.find("six planes") != std::string::npos);
+    }
+    TEST_CASE("window: scripted frames with key presses under the offscreen video driver") {
+        test::TempDir dir;
+        auto run = test::runProgram(
+            program, "--width 64 --height 48 --frames 4 --keys m,d,m,Left --screenshot shot.png",
+            dir, "SDL_VIDEODRIVER=offscreen");
+        INFO(run.err);
+        REQUIRE(run.exitCode == 0);
+        CHECK(test::pngSize(dir.file("shot.png")).first > 0);
+    }
+    TEST_CASE("bad input: one clear line and a non-zero exit") {
+        test::TempDir dir;
+        struct Case {
+            std::string args, expect;
+            int code;
+        };
+        for (const Case& c :
+             std::vector<Case>{{"--scene nosuchscene", "unknown scene", 1},
+                               {"--method cubes", "method", 2},
+                               {"--frobnicate", "frobnicate", 2},
+                               {"--rays-per-box 0", "rays-per-box", 2},
+                               {"--eye 1,2,3 --look 1,2,3", "view direction is zero", 1}}) {
+            INFO(c.args);
+            auto run = test::runProgram(program, "--headless --out bad.png " + c.args, dir);
+            CHECK(run.exitCode == c.code);
+            CHECK(test::lineCount(run.err) == 1);
+            CHECK(run.err.find(c.expect) != std::string::npos);
+            CHECK_FALSE(std::filesystem::exists(dir.file("bad.png")));
+        }
+    }
+}

@@ -1,0 +1,134 @@
+#!/usr/bin/python3
+"""Writes a starter kit: a copy of the workbook's tracked files (git ls-files; no build
+output) with every solution block replaced by a stub that throws NotImplemented("N.M").
+
+usage: tools/kit.py DIR        (./workbook kit DIR)
+
+Nothing between the markers survives: the kit's file is the reference file with each
+block's lines (from BEGIN SOLUTION to END SOLUTION, both included) replaced by the stub, and
+the tool checks that before it finishes. The stub also names the function's parameters as
+(void) casts, so the kit compiles without unused-parameter warnings.
+"""
+import os
+import shutil
+import subprocess
+import sys
+
+sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
+from exercises import BEGIN, END, SOURCE_SUFFIXES, parse_file  # noqa: E402
+
+ROOT = os.path.dirname(os.path.dirname(os.path.abspath(__file__)))
+SKIP_DIRS = {".git", "build", "out", "kit", "node_modules", "__pycache__"}
+
+
+def tracked_files(root):
+    """The tree's files that git tracks or would track (not ignored build output), or,
+    outside git, every file but build output."""
+    try:
+        out = subprocess.run(["git", "-C", root, "ls-files", "-z", "--cached", "--others",
+                              "--exclude-standard"], check=True,
+                             capture_output=True, text=True).stdout
+        files = [f for f in out.split("\0") if f and os.path.isfile(os.path.join(root, f))]
+        if files:
+            return files
+    except (OSError, subprocess.CalledProcessError):
+        pass
+    files = []
+    for base, dirs, names in os.walk(root):
+        dirs[:] = [d for d in dirs if d not in SKIP_DIRS]
+        files += [os.path.relpath(os.path.join(base, n), root) for n in names]
+    return sorted(files)
+
+
+def stub_lines(ex, indent):
+    """The lines that replace one solution block."""
+    lines = [f"{indent}// TODO: your solution (see the step's README)"]
+    if ex.parameters:
+        lines.append(indent + " ".join(f"(void){p};" for p in ex.parameters))
+    lines.append(f'{indent}throw NotImplemented("{ex.id}");')
+    return lines
+
+
+def strip_solutions(text, path, root, keep=()):
+    """The file's text with every solution block replaced (but those of the exercises in
+    `keep`, e.g. {"1.4"}); returns (new text, the exercises replaced)."""
+    lines = text.split("\n")
+    found = [e for e in parse_file(path, root) if e.id not in keep]
+    for ex in found:
+        if ex.begin < 0 or ex.end < 0:
+            raise SystemExit(f"kit: {ex.path}: exercise {ex.id} has no complete "
+                             "BEGIN SOLUTION ... END SOLUTION block")
+    for ex in sorted(found, key=lambda e: -e.begin):
+        indent = lines[ex.begin][: len(lines[ex.begin]) - len(lines[ex.begin].lstrip())]
+        lines[ex.begin : ex.end + 1] = stub_lines(ex, indent)
+    new = "\n".join(lines)
+    if found and "core/exercise.hpp" not in new:
+        # NotImplemented lives there; put the include after the file's first include.
+        at = next((i for i, l in enumerate(lines) if l.startswith("#include")), -1)
+        lines.insert(at + 1, '#include "core/exercise.hpp"')
+        new = "\n".join(lines)
+    return new, found
+
+
+def check_no_solution_left(reference, kit):
+    """Every line between markers in the reference is gone from the kit's file, unless
+    the same line also stands outside every block in the reference."""
+    ref_lines = reference.split("\n")
+    inside, outside, in_block = set(), set(), False
+    for line in ref_lines:
+        if BEGIN.match(line):
+            in_block = True
+            continue
+        if END.match(line):
+            in_block = False
+            continue
+        (inside if in_block else outside).add(line.strip())
+    kit_lines = {l.strip() for l in kit.split("\n")}
+    leaked = [l for l in inside if l and l not in outside and l in kit_lines]
+    if any(BEGIN.match(l) or END.match(l) for l in kit.split("\n")):
+        leaked.append("a BEGIN/END SOLUTION marker")
+    return leaked
+
+
+def write_kit(dest, root=ROOT):
+    if os.path.abspath(dest) == os.path.abspath(root):
+        raise SystemExit("kit: the kit must go into another folder than the workbook itself")
+    if os.path.exists(dest) and os.listdir(dest):
+        raise SystemExit(f"kit: {dest} exists and is not empty; choose a new folder")
+    stubbed = []
+    for rel in tracked_files(root):
+        src, dst = os.path.join(root, rel), os.path.join(dest, rel)
+        os.makedirs(os.path.dirname(dst), exist_ok=True)
+        if rel.startswith("steps/") and rel.endswith(SOURCE_SUFFIXES):
+            with open(src, encoding="utf-8") as f:
+                text = f.read()
+            new, found = strip_solutions(text, src, root)
+            leaked = check_no_solution_left(text, new)
+            if leaked:
+                raise SystemExit(f"kit: {rel}: solution text would survive: {leaked[0]!r}")
+            with open(dst, "w", encoding="utf-8") as f:
+                f.write(new)
+            shutil.copymode(src, dst)
+            stubbed += found
+        else:
+            shutil.copy2(src, dst)
+    return stubbed
+
+
+def main(argv):
+    if len(argv) != 1 or argv[0].startswith("-"):
+        print("usage: ./workbook kit DIR   (writes the starter kit into the new folder DIR)",
+              file=sys.stderr)
+        return 2
+    stubbed = write_kit(argv[0])
+    points = sum(e.points for e in stubbed)
+    print(f"[workbook] starter kit in {argv[0]}: {len(stubbed)} exercises ({points} points) "
+          "replaced by stubs that throw NotImplemented", file=sys.stderr)
+    for e in sorted(stubbed, key=lambda e: e.key):
+        print(f"  {e.id:>5}  {e.points} pt  {e.path}  {e.title}", file=sys.stderr)
+    print(f"[workbook] build and test it with: cd {argv[0]} && ./workbook test", file=sys.stderr)
+    return 0
+
+
+if __name__ == "__main__":
+    sys.exit(main(sys.argv[1:]))

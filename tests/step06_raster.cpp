@@ -7,6 +7,7 @@
 #include <random>
 
 #include "06_raster/compare.hpp"
+#include "06_raster/culling.hpp"
 #include "06_raster/measure.hpp"
 #include "06_raster/pipeline.hpp"
 #include "06_raster/raster.hpp"
@@ -180,7 +181,7 @@ TEST_SUITE("exercise 6.3") {
     TEST_CASE("a triangle crossing the near plane becomes a quad with the new vertices") {
         // a is outside (z + w = -1), b and c inside (z + w = 1).
         ClipPolygon out =
-            clipAgainstPlane(triangle({0, 0, -2, 1}, {0, 0, 0, 1}, {1, 0, 0, 1}), kNearPlane);
+            clipAgainstPlane(triangle({0, 0, -2, 1}, {0, 0, 0, 1}, {1, 0, 0, 1}), kClipNearPlane);
         REQUIRE(out.count == 4);
         checkVec(out.vertices[0].position, Vec4d(0, 0, -1, 1), 1e-15);
         checkVec(out.vertices[0].weights, glm::dvec3(0.5, 0.5, 0), 1e-15);
@@ -193,15 +194,15 @@ TEST_SUITE("exercise 6.3") {
     TEST_CASE(
         "one vertex inside: a smaller triangle; all inside: unchanged; all outside: nothing") {
         ClipPolygon one =
-            clipAgainstPlane(triangle({0, 0, 0, 1}, {0, 0, -3, 1}, {1, 0, -3, 1}), kNearPlane);
+            clipAgainstPlane(triangle({0, 0, 0, 1}, {0, 0, -3, 1}, {1, 0, -3, 1}), kClipNearPlane);
         REQUIRE(one.count == 3);
         for (int i = 0; i < 3; ++i)
-            CHECK(glm::dot(kNearPlane, one.vertices[size_t(i)].position) >= -1e-15);
+            CHECK(glm::dot(kClipNearPlane, one.vertices[size_t(i)].position) >= -1e-15);
         ClipPolygon all =
-            clipAgainstPlane(triangle({0, 0, 0, 1}, {1, 0, 0, 1}, {0, 1, 0, 1}), kNearPlane);
+            clipAgainstPlane(triangle({0, 0, 0, 1}, {1, 0, 0, 1}, {0, 1, 0, 1}), kClipNearPlane);
         CHECK(all.count == 3);
         ClipPolygon none =
-            clipAgainstPlane(triangle({0, 0, -2, 1}, {1, 0, -2, 1}, {0, 1, -2, 1}), kNearPlane);
+            clipAgainstPlane(triangle({0, 0, -2, 1}, {1, 0, -2, 1}, {0, 1, -2, 1}), kClipNearPlane);
         CHECK(none.count == 0);
     }
     TEST_CASE("hard case: a triangle through w = 0 keeps only its part in front of the eye") {
@@ -210,15 +211,15 @@ TEST_SUITE("exercise 6.3") {
         Mat4d p = glm::perspective(glm::radians(90.0), 1.0, 0.1, 100.0);
         ClipPolygon out = clipAgainstPlane(
             triangle(p * Vec4d(-1, -1, -2, 1), p * Vec4d(1, -1, -2, 1), p * Vec4d(0, -1, 3, 1)),
-            kNearPlane);
+            kClipNearPlane);
         REQUIRE(out.count == 4);
         for (int i = 0; i < out.count; ++i)
             CHECK(out.vertices[size_t(i)].position.w >= 0.1 - 1e-12);
     }
     TEST_CASE("hard case: two triangles sharing a clipped edge get the same new vertex") {
         Vec4d a(0.3, 0.1, -3.0, 1.7), b(-0.4, 0.2, 2.0, 2.5), c(1, 1, 1, 2), d(-1, 2, 1, 2);
-        ClipPolygon first = clipAgainstPlane(triangle(a, b, c), kNearPlane);
-        ClipPolygon second = clipAgainstPlane(triangle(b, a, d), kNearPlane);
+        ClipPolygon first = clipAgainstPlane(triangle(a, b, c), kClipNearPlane);
+        ClipPolygon second = clipAgainstPlane(triangle(b, a, d), kClipNearPlane);
         // The new vertex on the shared edge: weights only on its two ends.
         auto onEdge = [&](const ClipPolygon& p) {
             for (int i = 0; i < p.count; ++i) {
@@ -582,6 +583,44 @@ TEST_SUITE("shadows 06") {
     }
 }
 
+TEST_SUITE("frustum culling 06") {
+    void checkCulledIdentical(const Scene& s, const Camera& c) {
+        RasterScene raster = RasterScene::fromScene(s);
+        FrustumCuller culler(s.mesh);
+        RasterSettings rs;
+        rs.width = 160;
+        rs.height = 120;
+        FrameBuffers all, culled;
+        CullStats none, cull;
+        FrameStats full = rasterizeCulled(raster, nullptr, c, rs, all, none);
+        for (CullTest test : {CullTest::Planes, CullTest::PlanesAndCorners}) {
+            FrameStats stats = rasterizeCulled(raster, &culler, c, rs, culled, cull, test);
+            INFO("boxes culled " << cull.boxesCulled << " kept " << cull.boxesKept
+                                 << ", triangles kept " << cull.trianglesKept << " of "
+                                 << raster.meshTriangles);
+            CHECK(cull.boxesCulled > 0);
+            CHECK(cull.boxesVisited == cull.boxesCulled + cull.boxesKept);
+            CHECK(cull.trianglesKept < raster.meshTriangles);
+            CHECK(stats.trianglesIn < full.trianglesIn);
+            CHECK(stats.pixelsCovered == full.pixelsCovered);
+            CHECK(culled.triangle == all.triangle);
+            CHECK(culled.depth == all.depth);
+            CHECK(culled.weight1 == all.weight1);
+            CHECK(culled.weight2 == all.weight2);
+        }
+    }
+    TEST_CASE("the culled render is identical to the unculled one: bunny close-up") {
+        Scene s = makeScene("bunny", {test::dataDir(), 4.0f / 3.0f});
+        checkCulledIdentical(s, makeCamera(Vec3(-0.35f, 0.55f, 0.9f), Vec3(-0.45f, 0.5f, 0.0f),
+                                           Vec3(0, 1, 0), 40.0f, 4.0f / 3.0f));
+    }
+    TEST_CASE("the culled render is identical to the unculled one: inside a generated scene") {
+        Scene s = generatedScene(5);
+        checkCulledIdentical(s, makeCamera(Vec3(0.0f, 0.5f, 0.0f), Vec3(1.0f, 0.3f, 0.2f),
+                                           Vec3(0, 1, 0), 60.0f, 4.0f / 3.0f));
+    }
+}
+
 TEST_SUITE("program 06") {
     const std::string program = BOXES_PROGRAM;
 
@@ -614,6 +653,7 @@ TEST_SUITE("program 06") {
         }
         CHECK(covered > 200);
         CHECK(run.out.find("\"triangles_drawn\"") != std::string::npos);
+        CHECK(run.out.find("\"boxes_culled\"") != std::string::npos);
         CHECK(run.out.find("\"pixels_covered\": " + std::to_string(covered)) != std::string::npos);
     }
     TEST_CASE("compare mode prints the agreement and writes the difference image") {
@@ -634,17 +674,17 @@ TEST_SUITE("program 06") {
         REQUIRE(run.exitCode == 0);
         std::string json = test::readText(dir.file("r.json"));
         for (const char* id : {"\"visibility\"", "\"frame_time\"", "\"shadow_bias\"", "\"shadows\"",
-                               "\"interpolation\""})
+                               "\"interpolation\"", "\"culling\""})
             CHECK(json.find(id) != std::string::npos);
         CHECK(test::pngSize(dir.file("a-affine.png")) == std::pair{48, 36});
     }
     TEST_CASE("window: scripted frames with key presses under the offscreen video driver") {
         test::TempDir dir;
-        auto run =
-            test::runProgram(program,
-                             "--scene sh1 --width 64 --height 48 --frames 7 --keys r,d,h,b,p,Left "
-                             "--screenshot shot.png",
-                             dir, "SDL_VIDEODRIVER=offscreen");
+        auto run = test::runProgram(
+            program,
+            "--scene sh1 --width 64 --height 48 --frames 8 --keys r,d,h,b,p,f,Left "
+            "--screenshot shot.png",
+            dir, "SDL_VIDEODRIVER=offscreen");
         INFO(run.err);
         REQUIRE(run.exitCode == 0);
         CHECK(test::pngSize(dir.file("shot.png")).first > 0);

@@ -42,6 +42,10 @@ Table measureFrameTimes(const std::vector<MeasureView>& views, const MeasureSett
 // The shadow map's bias swept on one view; and both methods against the ray tracer.
 Table measureShadowBias(const MeasureView& view, const MeasureSettings& settings);
 Table measureShadowMethods(const MeasureView& view, const MeasureSettings& settings);
+// Frustum culling with step 04's hierarchy: boxes culled and kept, triangles drawn, time
+// per frame, and whether the image is identical to the unculled one.
+Table measureCulling(const std::vector<MeasureView>& views, const MeasureSettings& settings);
+
 // Affine against perspective-correct weights: the interpolated position's error against
 // the ray tracer's hit point, on a floor seen at a grazing angle and on the bunny; writes
 // the two checker images next to `pngStem` when it is not empty.

@@ -138,20 +138,19 @@ void FrameBuffers::reset(int w, int h, bool depthOnly) {
 }
 
 FrameStats rasterizeFrame(const RasterScene& scene, const Camera& camera,
-                          const RasterSettings& settings, FrameBuffers& buffers, size_t first,
-                          size_t last) {
+                          const RasterSettings& settings, FrameBuffers& buffers,
+                          const std::vector<uint32_t>* meshSubset) {
     Stopwatch watch;
     FrameStats stats;
     auto [near, far] = nearFarFor(scene, camera, settings);
     const Mat4d viewProjection = projectionMatrix(camera, near, far) * viewMatrix(camera);
     buffers.reset(settings.width, settings.height, settings.depthOnly);
     const int width = settings.width, height = settings.height;
-    std::array<Vec4d, 6> planes{kNearPlane, kFarPlane};
+    std::array<Vec4d, 6> planes{kClipNearPlane, kClipFarPlane};
     auto band = guardBandPlanes(settings.guardBand);
     std::copy(band.begin(), band.end(), planes.begin() + 2);
-    if (last == 0 || last > scene.triangles.size()) last = scene.triangles.size();
 
-    for (size_t t = first; t < last; ++t) {
+    auto draw = [&](size_t t) {
         ++stats.trianglesIn;
         const auto& tri = scene.triangles[t];
         ClipPolygon polygon;
@@ -172,7 +171,7 @@ FrameStats rasterizeFrame(const RasterScene& scene, const Camera& camera,
         }
         if (outside) {
             ++stats.culledOutside;
-            continue;
+            return;
         }
         if (!inside) {
             ++stats.clipped;
@@ -182,7 +181,7 @@ FrameStats rasterizeFrame(const RasterScene& scene, const Camera& camera,
             }
             if (polygon.count < 3) {
                 ++stats.culledOutside;
-                continue;
+                return;
             }
         }
         // The convex polygon as a fan; every piece keeps the triangle's winding.
@@ -234,6 +233,14 @@ FrameStats rasterizeFrame(const RasterScene& scene, const Camera& camera,
             ++stats.trianglesDrawn;
         else
             ++stats.culledBackface;
+    };
+    if (meshSubset) {
+        // The kept mesh triangles in file order, then everything else: the same order as
+        // the full frame, so z-buffer ties fall the same way.
+        for (uint32_t t : *meshSubset) draw(t);
+        for (size_t t = scene.meshTriangles; t < scene.triangles.size(); ++t) draw(t);
+    } else {
+        for (size_t t = 0; t < scene.triangles.size(); ++t) draw(t);
     }
     for (float d : buffers.depth) stats.pixelsCovered += d != kInfinity<float>;
     stats.milliseconds = watch.milliseconds();

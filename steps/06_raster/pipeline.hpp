@@ -69,10 +69,11 @@ struct FrameStats {
     double milliseconds = 0.0;
 };
 
-// Draws triangles [first, last) of the scene (all when last == 0) into the buffers.
+// Draws every triangle into the buffers; with meshSubset, only those mesh triangles (in
+// increasing order, e.g. what frustum culling kept) and every non-mesh triangle.
 FrameStats rasterizeFrame(const RasterScene& scene, const Camera& camera,
-                          const RasterSettings& settings, FrameBuffers& buffers, size_t first = 0,
-                          size_t last = 0);
+                          const RasterSettings& settings, FrameBuffers& buffers,
+                          const std::vector<uint32_t>* meshSubset = nullptr);
 
 // A shadow map for one point light: the scene's depth seen from the light, through a
 // square perspective view aimed at the scene's bounds (Williams 1978).

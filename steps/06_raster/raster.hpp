@@ -46,8 +46,8 @@ struct ClipPolygon {
 
 // A plane in homogeneous clip space: a point p is inside when dot(plane, p) >= 0.
 // The near plane with GLM's default depth is z + w >= 0; the far plane is w - z >= 0.
-constexpr Vec4d kNearPlane{0.0, 0.0, 1.0, 1.0};
-constexpr Vec4d kFarPlane{0.0, 0.0, -1.0, 1.0};
+constexpr Vec4d kClipNearPlane{0.0, 0.0, 1.0, 1.0};
+constexpr Vec4d kClipFarPlane{0.0, 0.0, -1.0, 1.0};
 // The guard band: |x| <= g w and |y| <= g w, so screen coordinates stay within g times the
 // image and fit the fixed-point edge functions; triangles inside the band are not clipped.
 inline std::array<Vec4d, 4> guardBandPlanes(double g) {

@@ -128,7 +128,8 @@ Table measureFrameTimes(const std::vector<MeasureView>& views, const MeasureSett
     t.note = std::to_string(m.width) + "x" + std::to_string(m.height) + ", median of " +
              std::to_string(m.repeats) +
              " frames; raster shaded: deferred shading of the z-buffer without shadows; the shadow "
-             "map is rebuilt every frame (2048^2); the ray tracer uses step 01's uniform grid";
+             "map is rebuilt every frame (" +
+             std::to_string(m.mapSize()) + "^2); the ray tracer uses step 01's uniform grid";
     for (const MeasureView& v : views) {
         std::cerr << "06_raster: timing frames on " << v.name << "...\n";
         RasterScene raster = RasterScene::fromScene(v.scene);
@@ -139,6 +140,7 @@ Table measureFrameTimes(const std::vector<MeasureView>& views, const MeasureSett
         auto shaded = [&](ShadowMode mode) {
             ShadeSettings ss;
             ss.shadows = mode;
+            ss.mapSize = m.mapSize();
             return medianMs(m.repeats, [&] {
                 rasterizeFrame(raster, v.camera, rs, buffers);
                 keepValue(shadeFrame(v.scene, raster, v.camera, buffers, ss).image.pixels()[0].x);
@@ -175,7 +177,7 @@ Table measureShadowBias(const MeasureView& v, const MeasureSettings& m) {
     rasterizeFrame(raster, v.camera, rasterSettings(m), buffers);
     TracedFrame traced = traceFrame(v.scene, v.camera, m.width, m.height, true, 0);
     std::vector<uint32_t> ids = meshIds(raster, buffers);
-    for (int size : {1024, 2048}) {
+    for (int size : {m.mapSize() / 2, m.mapSize()}) {
         std::vector<ShadowMap> maps;
         for (const PointLight& light : v.scene.lights)
             maps.push_back(buildShadowMap(raster, light, size));
@@ -207,6 +209,7 @@ Table measureShadowMethods(const MeasureView& v, const MeasureSettings& m) {
     for (ShadowMode mode : {ShadowMode::Map, ShadowMode::Rays}) {
         ShadeSettings ss;
         ss.shadows = mode;
+        ss.mapSize = m.mapSize();
         ShadedFrame f;
         double ms = medianMs(m.repeats, [&] {
             rasterizeFrame(raster, v.camera, rs, buffers);

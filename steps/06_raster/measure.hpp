@@ -4,6 +4,7 @@
 // perspective-correct interpolation.
 #pragma once
 
+#include <algorithm>
 #include <memory>
 #include <string>
 #include <vector>
@@ -35,6 +36,9 @@ std::string findSharedMeshes(const std::string& dataDir);
 struct MeasureSettings {
     int width = 640, height = 480;
     int repeats = 3;
+    // Shadow map size: four texels per pixel of the image's larger side, 256 to 2048 (the
+    // bias sweep also tries half of it).
+    int mapSize() const { return std::clamp(4 * std::max(width, height), 256, 2048); }
 };
 
 Table measureVisibility(const std::vector<MeasureView>& views, const MeasureSettings& settings);

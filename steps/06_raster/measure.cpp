@@ -311,7 +311,7 @@ Table measureInterpolation(const MeasureView& bunny, const MeasureSettings& m,
     floor.scene.mesh.triangles = {{0, 2, 1}, {0, 3, 2}};
     floor.scene.mesh.computeVertexNormals();
     floor.scene.lights.push_back({Vec3(0, 6, 0), Vec3(60.0f), kInfinity<float>});
-    floor.camera = lookAt(Vec3(0, 1.0f, 9.5f), Vec3(0, 0, 0), Vec3(0, 1, 0), 60.0f,
+    floor.camera = lookAt(Vec3(0, 2.5f, 13.0f), Vec3(0, 0, 2.0f), Vec3(0, 1, 0), 60.0f,
                           float(m.width) / float(m.height));
     attachGrid(floor.scene);
     for (const MeasureView* v : {static_cast<const MeasureView*>(&floor), &bunny}) {

@@ -287,7 +287,7 @@ bool litByShadowMap(const ShadowMap& map, const Vec3& point, double bias) {
     // END SOLUTION
 }
 
-// EXERCISE 6.9: the hybrid: a shadow ray from the rasterized position through the scene (1 point)
+// EXERCISE 6.9: the hybrid: a shadow ray from the rasterized position (1 point)
 bool litByShadowRay(const Scene& scene, const Vec3& point, const Vec3& geometricNormal,
                     const PointLight& light) {
     // BEGIN SOLUTION

@@ -20,6 +20,11 @@ using Mat4d = glm::dmat4;
 // GLM's default clip depth: the near plane maps to z/w = -1, the far plane to +1). Built
 // from the core's one camera model (eye, view direction, up, vertical field of view,
 // aspect ratio), so pixel centres match the ray tracer's primary rays.
+struct SpaceMatrices {
+    Mat4d view{1.0}, projection{1.0};
+};
+SpaceMatrices spaceMatrices(const Camera& camera, double near, double far);
+// The two parts of spaceMatrices.
 Mat4d viewMatrix(const Camera& camera);
 Mat4d projectionMatrix(const Camera& camera, double near, double far);
 

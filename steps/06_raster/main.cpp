@@ -124,7 +124,8 @@ int main(int argc, char** argv) {
                                               shadowModeName(ss.shadows)});
             if (!idsPath.empty()) writeBuffer(idsPath, meshIds(raster, buffers));
             if (!depthPath.empty()) writeBuffer(depthPath, meshDepths(raster, buffers));
-            report.facts["triangles"] = stats.trianglesIn;
+            report.facts["triangles"] = raster.triangles.size();
+            report.facts["triangles_after_culling"] = stats.trianglesIn;
             report.facts["triangles_drawn"] = stats.trianglesDrawn;
             const size_t frustumCulled =
                 culling && culler ? raster.meshTriangles - cull.trianglesKept : 0;
@@ -144,8 +145,8 @@ int main(int argc, char** argv) {
             report.facts["shade_ms"] = shaded.milliseconds;
             report.facts["frame_ms"] = stats.milliseconds + shaded.milliseconds;
             std::cerr << "06_raster: wrote " << out << " (" << rs.width << "x" << rs.height << ", "
-                      << stats.trianglesDrawn << " of " << stats.trianglesIn << " triangles drawn, "
-                      << stats.pixelsCovered << " pixels covered, raster "
+                      << stats.trianglesDrawn << " of " << raster.triangles.size()
+                      << " triangles drawn, " << stats.pixelsCovered << " pixels covered, raster "
                       << formatSeconds(stats.milliseconds * 1e-3) << ", shading "
                       << formatSeconds(shaded.milliseconds * 1e-3) << ")\n";
             if (compare) {
@@ -308,7 +309,7 @@ int main(int argc, char** argv) {
             ImGui::Text("raster: %.1f ms + shading %.1f ms (1 thread)", rasterMs, shadeMs);
             if (view != View::Raster) ImGui::Text("ray tracer: %.1f ms", tracedMs);
             ImGui::Text("triangles drawn %zu of %zu, pixels %zu", stats.trianglesDrawn,
-                        stats.trianglesIn, stats.pixelsCovered);
+                        raster.triangles.size(), stats.pixelsCovered);
             if (culling && culler)
                 ImGui::Text("frustum culling: %zu boxes culled, %zu kept, %zu triangles kept",
                             cull.boxesCulled, cull.boxesKept, cull.trianglesKept);

@@ -684,7 +684,7 @@ TEST_SUITE("program 06") {
             program,
             "--scene sh1 --width 64 --height 48 --frames 8 --keys r,d,h,b,p,f,Left "
             "--screenshot shot.png",
-            dir, "SDL_VIDEODRIVER=offscreen");
+            dir, test::kWindowEnvironment);
         INFO(run.err);
         REQUIRE(run.exitCode == 0);
         CHECK(test::pngSize(dir.file("shot.png")).first > 0);

@@ -48,7 +48,7 @@ VisibilityComparison compareVisibility(int width, int height,
                                        const std::vector<uint32_t>& rasterIds,
                                        const std::vector<float>& rasterDepth,
                                        const std::vector<uint32_t>& tracedIds,
-                                       const std::vector<float>& tracedDepth) {
+                                       const std::vector<float>& tracedDepth, const Mesh* mesh) {
     VisibilityComparison c;
     c.pixels = size_t(width) * size_t(height);
     // Is `id` seen within one pixel of (x, y) in `ids`?
@@ -59,6 +59,14 @@ VisibilityComparison compareVisibility(int width, int height,
                 if (u < 0 || v < 0 || u >= width || v >= height) continue;
                 if (ids[size_t(v) * size_t(width) + size_t(u)] == id) return true;
             }
+        return false;
+    };
+    auto shareVertex = [&](uint32_t a, uint32_t b) {
+        if (!mesh || a == kNoPrimitive || b == kNoPrimitive) return false;
+        if (a >= mesh->triangles.size() || b >= mesh->triangles.size()) return false;
+        for (uint32_t i : mesh->triangles[a])
+            for (uint32_t j : mesh->triangles[b])
+                if (i == j || mesh->positions[i] == mesh->positions[j]) return true;
         return false;
     };
     double depthSum = 0.0;
@@ -76,7 +84,7 @@ VisibilityComparison compareVisibility(int width, int height,
                            double(tracedDepth[i]);
                 c.maxDepthError = std::max(c.maxDepthError, e);
                 depthSum += e;
-            } else if (near(tracedIds, x, y, r) || near(rasterIds, x, y, t)) {
+            } else if (near(tracedIds, x, y, r) || near(rasterIds, x, y, t) || shareVertex(r, t)) {
                 ++c.differOnEdge;
             } else {
                 ++c.differElsewhere;

@@ -39,12 +39,17 @@ struct VisibilityComparison {
                       : 0.0;
     }
 };
-// Both id buffers row-major, the same size; depths as in the --depth file.
+// Both id buffers row-major, the same size; depths as in the --depth file. A pixel where
+// they name different triangles counts as "on an edge" when the two triangles share a
+// vertex of `mesh` (the pixel centre is near their common edge or corner) or the other's
+// triangle is seen within one pixel; a pixel covered by one only, when the other's
+// neighbourhood shows the covering triangle (a silhouette edge).
 VisibilityComparison compareVisibility(int width, int height,
                                        const std::vector<uint32_t>& rasterIds,
                                        const std::vector<float>& rasterDepth,
                                        const std::vector<uint32_t>& tracedIds,
-                                       const std::vector<float>& tracedDepth);
+                                       const std::vector<float>& tracedDepth,
+                                       const Mesh* mesh = nullptr);
 
 struct ShadowComparison {
     size_t compared = 0;  // pixels where both see the same triangle and the light can reach

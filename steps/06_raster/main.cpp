@@ -7,6 +7,7 @@
 #include <iostream>
 
 #include "06_raster/compare.hpp"
+#include "06_raster/culling.hpp"
 #include "06_raster/measure.hpp"
 #include "06_raster/pipeline.hpp"
 #include "core/app.hpp"
@@ -69,7 +70,9 @@ int main(int argc, char** argv) {
         app.add_option("--map-size", mapSize, "shadow map size in texels")
             ->check(CLI::Range(16, 8192));
         app.add_flag("--backface", rs.backfaceCulling, "cull back faces");
-        bool affine = false, checker = false, compare = false, measure = false;
+        bool affine = false, checker = false, compare = false, measure = false, noCull = false;
+        app.add_flag("--no-cull", noCull,
+                     "draw every triangle (no frustum culling with step 04's hierarchy)");
         app.add_flag("--affine", affine,
                      "interpolate affinely in screen space (warps) instead of with 1/w");
         app.add_flag("--checker", checker,
@@ -83,6 +86,10 @@ int main(int argc, char** argv) {
         Scene scene = sceneFromOptions(opts);
         attachGrid(scene);
         RasterScene raster = RasterScene::fromScene(scene);
+        std::unique_ptr<FrustumCuller> culler;
+        if (scene.hasMesh()) culler = std::make_unique<FrustumCuller>(scene.mesh);
+        bool culling = !noCull;
+        CullStats cull;
         if (nearOption->count()) {
             if (!(nearFlag > 0.0) || !std::isfinite(nearFlag))
                 throw InputError("--near must be greater than 0");
@@ -109,16 +116,26 @@ int main(int argc, char** argv) {
             report.program = "06_raster";
             std::string out = opts.out.empty() ? "06_raster.png" : opts.out;
             FrameBuffers buffers;
-            FrameStats stats = rasterizeFrame(raster, scene.camera, rs, buffers);
+            FrameStats stats = rasterizeCulled(raster, culling ? culler.get() : nullptr,
+                                               scene.camera, rs, buffers, cull);
             ShadedFrame shaded = shadeFrame(scene, raster, scene.camera, buffers, ss);
             shaded.image.writePng(out);
             report.images.push_back({out, "scene '" + scene.name + "' rasterized, shadows: " +
                                               shadowModeName(ss.shadows)});
             if (!idsPath.empty()) writeBuffer(idsPath, meshIds(raster, buffers));
             if (!depthPath.empty()) writeBuffer(depthPath, meshDepths(raster, buffers));
-            report.facts["triangles"] = stats.trianglesIn;
+            report.facts["triangles"] = raster.triangles.size();
+            report.facts["triangles_after_culling"] = stats.trianglesIn;
             report.facts["triangles_drawn"] = stats.trianglesDrawn;
-            report.facts["triangles_culled"] = stats.culledOutside + stats.culledBackface;
+            const size_t frustumCulled =
+                culling && culler ? raster.meshTriangles - cull.trianglesKept : 0;
+            report.facts["triangles_culled"] =
+                frustumCulled + stats.culledOutside + stats.culledBackface;
+            report.facts["triangles_frustum_culled"] = frustumCulled;
+            report.facts["boxes_visited"] = cull.boxesVisited;
+            report.facts["boxes_culled"] = cull.boxesCulled;
+            report.facts["boxes_kept"] = cull.boxesKept;
+            report.facts["cull_ms"] = cull.milliseconds;
             report.facts["triangles_outside"] = stats.culledOutside;
             report.facts["triangles_backface_or_empty"] = stats.culledBackface;
             report.facts["triangles_clipped"] = stats.clipped;
@@ -128,15 +145,15 @@ int main(int argc, char** argv) {
             report.facts["shade_ms"] = shaded.milliseconds;
             report.facts["frame_ms"] = stats.milliseconds + shaded.milliseconds;
             std::cerr << "06_raster: wrote " << out << " (" << rs.width << "x" << rs.height << ", "
-                      << stats.trianglesDrawn << " of " << stats.trianglesIn << " triangles drawn, "
-                      << stats.pixelsCovered << " pixels covered, raster "
+                      << stats.trianglesDrawn << " of " << raster.triangles.size()
+                      << " triangles drawn, " << stats.pixelsCovered << " pixels covered, raster "
                       << formatSeconds(stats.milliseconds * 1e-3) << ", shading "
                       << formatSeconds(shaded.milliseconds * 1e-3) << ")\n";
             if (compare) {
                 TracedFrame traced = traceFrame(scene, scene.camera, rs.width, rs.height, true, 1);
-                VisibilityComparison c =
-                    compareVisibility(rs.width, rs.height, meshIds(raster, buffers),
-                                      meshDepths(raster, buffers), traced.ids, traced.depth);
+                VisibilityComparison c = compareVisibility(
+                    rs.width, rs.height, meshIds(raster, buffers), meshDepths(raster, buffers),
+                    traced.ids, traced.depth, &scene.mesh);
                 std::string diff = withSuffix(out, "-diff.png");
                 differenceImage(rs.width, rs.height, meshIds(raster, buffers), traced.ids)
                     .writePng(diff);
@@ -185,6 +202,7 @@ int main(int argc, char** argv) {
                     measureViews(opts.dataDir, findSharedMeshes(opts.dataDir), opts.aspect());
                 report.add(measureVisibility(views, ms));
                 report.add(measureFrameTimes(views, ms));
+                report.add(measureCulling(views, ms));
                 std::cerr << "06_raster: shadows...\n";
                 report.add(measureShadowBias(views[0], ms));
                 report.add(measureShadowMethods(views[0], ms));
@@ -226,7 +244,8 @@ int main(int argc, char** argv) {
                    {SDLK_h, "shadows: none / shadow map / shadow rays"},
                    {SDLK_b, "back-face culling on / off"},
                    {SDLK_p, "perspective-correct / affine interpolation"},
-                   {SDLK_c, "checker on the surfaces (shows the interpolation)"}};
+                   {SDLK_c, "checker on the surfaces (shows the interpolation)"},
+                   {SDLK_f, "frustum culling with step 04's hierarchy on / off"}};
         for (const KeyBinding& k : OrbitController::keys()) cb.keys.push_back(k);
         cb.onKey = [&](int key) {
             switch (key) {
@@ -261,7 +280,8 @@ int main(int argc, char** argv) {
             if (!dirty) return image;
             const Camera& camera = orbit.camera();
             FrameBuffers buffers;
-            stats = rasterizeFrame(raster, camera, rs, buffers);
+            stats = rasterizeCulled(raster, culling ? culler.get() : nullptr, camera, rs, buffers,
+                                    cull);
             ShadedFrame shaded = shadeFrame(scene, raster, camera, buffers, ss);
             rasterMs = stats.milliseconds;
             shadeMs = shaded.milliseconds;
@@ -277,7 +297,7 @@ int main(int argc, char** argv) {
                 tracedMs = traced.milliseconds;
                 std::vector<uint32_t> ids = meshIds(raster, buffers);
                 diff = compareVisibility(rs.width, rs.height, ids, meshDepths(raster, buffers),
-                                         traced.ids, traced.depth);
+                                         traced.ids, traced.depth, &scene.mesh);
                 image = differenceImage(rs.width, rs.height, ids, traced.ids);
             }
             dirty = false;
@@ -289,7 +309,12 @@ int main(int argc, char** argv) {
             ImGui::Text("raster: %.1f ms + shading %.1f ms (1 thread)", rasterMs, shadeMs);
             if (view != View::Raster) ImGui::Text("ray tracer: %.1f ms", tracedMs);
             ImGui::Text("triangles drawn %zu of %zu, pixels %zu", stats.trianglesDrawn,
-                        stats.trianglesIn, stats.pixelsCovered);
+                        raster.triangles.size(), stats.pixelsCovered);
+            if (culling && culler)
+                ImGui::Text("frustum culling: %zu boxes culled, %zu kept, %zu triangles kept",
+                            cull.boxesCulled, cull.boxesKept, cull.trianglesKept);
+            else
+                ImGui::Text("frustum culling: off");
             ImGui::Text("shadows: %s, back faces %s, %s", shadowModeName(ss.shadows),
                         rs.backfaceCulling ? "culled" : "drawn",
                         rs.perspectiveCorrect ? "perspective-correct" : "affine");

@@ -5,6 +5,8 @@
 #include <iostream>
 
 #include "01_triangle/triangle_grid.hpp"
+#include "04_bvh/trace.hpp"
+#include "06_raster/culling.hpp"
 #include "core/render.hpp"
 #include "core/timing.hpp"
 
@@ -102,7 +104,7 @@ Table measureVisibility(const std::vector<MeasureView>& views, const MeasureSett
         TracedFrame traced = traceFrame(v.scene, v.camera, m.width, m.height, false, 0);
         VisibilityComparison c =
             compareVisibility(m.width, m.height, meshIds(raster, buffers),
-                              meshDepths(raster, buffers), traced.ids, traced.depth);
+                              meshDepths(raster, buffers), traced.ids, traced.depth, &v.scene.mesh);
         t.row({v.name, (long long)raster.meshTriangles, (long long)c.coveredRaster,
                (long long)c.coveredTraced, 100.0 * c.agreement(), (long long)c.differOnEdge,
                (long long)c.differElsewhere, 100.0 * c.coverageDifference(), c.maxDepthError});
@@ -126,7 +128,8 @@ Table measureFrameTimes(const std::vector<MeasureView>& views, const MeasureSett
     t.note = std::to_string(m.width) + "x" + std::to_string(m.height) + ", median of " +
              std::to_string(m.repeats) +
              " frames; raster shaded: deferred shading of the z-buffer without shadows; the shadow "
-             "map is rebuilt every frame (2048^2); the ray tracer uses step 01's uniform grid";
+             "map is rebuilt every frame (" +
+             std::to_string(m.mapSize()) + "^2); the ray tracer uses step 01's uniform grid";
     for (const MeasureView& v : views) {
         std::cerr << "06_raster: timing frames on " << v.name << "...\n";
         RasterScene raster = RasterScene::fromScene(v.scene);
@@ -137,6 +140,7 @@ Table measureFrameTimes(const std::vector<MeasureView>& views, const MeasureSett
         auto shaded = [&](ShadowMode mode) {
             ShadeSettings ss;
             ss.shadows = mode;
+            ss.mapSize = m.mapSize();
             return medianMs(m.repeats, [&] {
                 rasterizeFrame(raster, v.camera, rs, buffers);
                 keepValue(shadeFrame(v.scene, raster, v.camera, buffers, ss).image.pixels()[0].x);
@@ -173,7 +177,7 @@ Table measureShadowBias(const MeasureView& v, const MeasureSettings& m) {
     rasterizeFrame(raster, v.camera, rasterSettings(m), buffers);
     TracedFrame traced = traceFrame(v.scene, v.camera, m.width, m.height, true, 0);
     std::vector<uint32_t> ids = meshIds(raster, buffers);
-    for (int size : {1024, 4096}) {
+    for (int size : {m.mapSize() / 2, m.mapSize()}) {
         std::vector<ShadowMap> maps;
         for (const PointLight& light : v.scene.lights)
             maps.push_back(buildShadowMap(raster, light, size));
@@ -205,6 +209,7 @@ Table measureShadowMethods(const MeasureView& v, const MeasureSettings& m) {
     for (ShadowMode mode : {ShadowMode::Map, ShadowMode::Rays}) {
         ShadeSettings ss;
         ss.shadows = mode;
+        ss.mapSize = m.mapSize();
         ShadedFrame f;
         double ms = medianMs(m.repeats, [&] {
             rasterizeFrame(raster, v.camera, rs, buffers);
@@ -215,8 +220,76 @@ Table measureShadowMethods(const MeasureView& v, const MeasureSettings& m) {
         t.row({std::string(shadowModeName(mode)), (long long)c.compared,
                (long long)(c.acne + c.leaks), 100.0 * c.disagreement(), ms});
     }
+    {
+        // The hybrid again, its shadow rays through step 04's hierarchy instead of the grid.
+        Scene bvhScene = v.scene;
+        bvhScene.geometries.clear();
+        if (bvhScene.hasMesh())
+            bvhScene.geometries.push_back(std::make_shared<MeshBvhGeometry>(
+                bvhScene.mesh, bvhScene.meshMaterial, BvhBuildOptions{}));
+        ShadeSettings ss;
+        ss.shadows = ShadowMode::Rays;
+        ShadedFrame f;
+        double ms = medianMs(m.repeats, [&] {
+            rasterizeFrame(raster, v.camera, rs, buffers);
+            f = shadeFrame(bvhScene, raster, v.camera, buffers, ss);
+        });
+        ShadowComparison c = compareShadows(meshIds(raster, buffers), f.litByFirstLight, traced.ids,
+                                            traced.litByFirstLight);
+        t.row({std::string("shadow rays (hybrid) through step 04's BVH"), (long long)c.compared,
+               (long long)(c.acne + c.leaks), 100.0 * c.disagreement(), ms});
+    }
     t.row(
         {std::string("ray tracer (visibility + shadow rays)"), 0LL, 0LL, 0.0, traced.milliseconds});
+    return t;
+}
+
+Table measureCulling(const std::vector<MeasureView>& views, const MeasureSettings& m) {
+    Table t;
+    t.id = "culling";
+    t.title =
+        "View-frustum culling with step 04's hierarchy: boxes culled and kept, triangles drawn";
+    t.columns = {"view",       "test",           "boxes visited",   "boxes culled",
+                 "boxes kept", "triangles kept", "triangles drawn", "ms per frame",
+                 "identical"};
+    t.note =
+        "binned-SAH hierarchy over the mesh; test: none, planes (p-vertex), planes + corners; "
+        "ms: median of " +
+        std::to_string(m.repeats) +
+        " frames (culling walk + rasterizing, single thread); identical: the triangle "
+        "and depth buffers equal the unculled frame's";
+    std::vector<MeasureView> cases;
+    for (const MeasureView& v : views) cases.push_back(v);
+    // The bunny's head from close by: a good share of the mesh lies outside the view.
+    MeasureView close = views[0];
+    close.name = "bunny (close-up)";
+    close.camera.eye = Vec3(-0.35f, 0.55f, 0.9f);
+    close.camera.view = Vec3(-0.45f, 0.5f, 0.0f) - close.camera.eye;
+    close.camera.fovYDegrees = 40.0f;
+    cases.insert(cases.begin() + 1, close);
+    for (const MeasureView& v : cases) {
+        std::cerr << "06_raster: culling on " << v.name << "...\n";
+        RasterScene raster = RasterScene::fromScene(v.scene);
+        FrustumCuller culler(v.scene.mesh);
+        RasterSettings rs = rasterSettings(m);
+        FrameBuffers reference, buffers;
+        CullStats cull;
+        rasterizeCulled(raster, nullptr, v.camera, rs, reference, cull);
+        for (int test = -1; test < 2; ++test) {
+            const FrustumCuller* c = test < 0 ? nullptr : &culler;
+            CullTest which = test == 1 ? CullTest::PlanesAndCorners : CullTest::Planes;
+            FrameStats stats;
+            double ms = medianMs(m.repeats, [&] {
+                stats = rasterizeCulled(raster, c, v.camera, rs, buffers, cull, which);
+            });
+            bool same = buffers.triangle == reference.triangle && buffers.depth == reference.depth;
+            const char* name = test < 0 ? "none" : test == 0 ? "planes" : "planes + corners";
+            t.row({v.name, std::string(name), (long long)cull.boxesVisited,
+                   (long long)cull.boxesCulled, (long long)cull.boxesKept,
+                   (long long)(c ? cull.trianglesKept : raster.meshTriangles),
+                   (long long)stats.trianglesDrawn, ms, std::string(same ? "yes" : "NO")});
+        }
+    }
     return t;
 }
 
@@ -238,7 +311,7 @@ Table measureInterpolation(const MeasureView& bunny, const MeasureSettings& m,
     floor.scene.mesh.triangles = {{0, 2, 1}, {0, 3, 2}};
     floor.scene.mesh.computeVertexNormals();
     floor.scene.lights.push_back({Vec3(0, 6, 0), Vec3(60.0f), kInfinity<float>});
-    floor.camera = lookAt(Vec3(0, 1.0f, 9.5f), Vec3(0, 0, 0), Vec3(0, 1, 0), 60.0f,
+    floor.camera = lookAt(Vec3(0, 2.5f, 13.0f), Vec3(0, 0, 2.0f), Vec3(0, 1, 0), 60.0f,
                           float(m.width) / float(m.height));
     attachGrid(floor.scene);
     for (const MeasureView* v : {static_cast<const MeasureView*>(&floor), &bunny}) {

@@ -4,6 +4,7 @@
 // perspective-correct interpolation.
 #pragma once
 
+#include <algorithm>
 #include <memory>
 #include <string>
 #include <vector>
@@ -35,6 +36,9 @@ std::string findSharedMeshes(const std::string& dataDir);
 struct MeasureSettings {
     int width = 640, height = 480;
     int repeats = 3;
+    // Shadow map size: four texels per pixel of the image's larger side, 256 to 2048 (the
+    // bias sweep also tries half of it).
+    int mapSize() const { return std::clamp(4 * std::max(width, height), 256, 2048); }
 };
 
 Table measureVisibility(const std::vector<MeasureView>& views, const MeasureSettings& settings);
@@ -42,6 +46,10 @@ Table measureFrameTimes(const std::vector<MeasureView>& views, const MeasureSett
 // The shadow map's bias swept on one view; and both methods against the ray tracer.
 Table measureShadowBias(const MeasureView& view, const MeasureSettings& settings);
 Table measureShadowMethods(const MeasureView& view, const MeasureSettings& settings);
+// Frustum culling with step 04's hierarchy: boxes culled and kept, triangles drawn, time
+// per frame, and whether the image is identical to the unculled one.
+Table measureCulling(const std::vector<MeasureView>& views, const MeasureSettings& settings);
+
 // Affine against perspective-correct weights: the interpolated position's error against
 // the ray tracer's hit point, on a floor seen at a grazing angle and on the bunny; writes
 // the two checker images next to `pngStem` when it is not empty.

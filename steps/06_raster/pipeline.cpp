@@ -126,32 +126,31 @@ std::pair<double, double> nearFarFor(const RasterScene& scene, const Camera& cam
     return {near, far};
 }
 
-void FrameBuffers::reset(int w, int h) {
+void FrameBuffers::reset(int w, int h, bool depthOnly) {
     if (w <= 0 || h <= 0) throw InputError("image size must be positive");
     width = w;
     height = h;
     size_t n = size_t(w) * size_t(h);
-    triangle.assign(n, kNoPrimitive);
     depth.assign(n, kInfinity<float>);
-    weight1.assign(n, 0.0f);
-    weight2.assign(n, 0.0f);
+    triangle.assign(depthOnly ? 0 : n, kNoPrimitive);
+    weight1.assign(depthOnly ? 0 : n, 0.0f);
+    weight2.assign(depthOnly ? 0 : n, 0.0f);
 }
 
 FrameStats rasterizeFrame(const RasterScene& scene, const Camera& camera,
-                          const RasterSettings& settings, FrameBuffers& buffers, size_t first,
-                          size_t last) {
+                          const RasterSettings& settings, FrameBuffers& buffers,
+                          const std::vector<uint32_t>* meshSubset) {
     Stopwatch watch;
     FrameStats stats;
     auto [near, far] = nearFarFor(scene, camera, settings);
     const Mat4d viewProjection = projectionMatrix(camera, near, far) * viewMatrix(camera);
-    buffers.reset(settings.width, settings.height);
+    buffers.reset(settings.width, settings.height, settings.depthOnly);
     const int width = settings.width, height = settings.height;
-    std::array<Vec4d, 6> planes{kNearPlane, kFarPlane};
+    std::array<Vec4d, 6> planes{kClipNearPlane, kClipFarPlane};
     auto band = guardBandPlanes(settings.guardBand);
     std::copy(band.begin(), band.end(), planes.begin() + 2);
-    if (last == 0 || last > scene.triangles.size()) last = scene.triangles.size();
 
-    for (size_t t = first; t < last; ++t) {
+    auto draw = [&](size_t t) {
         ++stats.trianglesIn;
         const auto& tri = scene.triangles[t];
         ClipPolygon polygon;
@@ -172,7 +171,7 @@ FrameStats rasterizeFrame(const RasterScene& scene, const Camera& camera,
         }
         if (outside) {
             ++stats.culledOutside;
-            continue;
+            return;
         }
         if (!inside) {
             ++stats.clipped;
@@ -182,7 +181,7 @@ FrameStats rasterizeFrame(const RasterScene& scene, const Camera& camera,
             }
             if (polygon.count < 3) {
                 ++stats.culledOutside;
-                continue;
+                return;
             }
         }
         // The convex polygon as a fan; every piece keeps the triangle's winding.
@@ -191,20 +190,35 @@ FrameStats rasterizeFrame(const RasterScene& scene, const Camera& camera,
             const ClipVertex* v[3] = {&polygon.vertices[0], &polygon.vertices[size_t(k)],
                                       &polygon.vertices[size_t(k + 1)]};
             FixedPoint2 s[3];
+            glm::dvec2 exact[3];
             glm::dvec3 w;
             for (int i = 0; i < 3; ++i) {
                 glm::dvec3 p = clipToScreen(v[i]->position, width, height);
+                exact[i] = glm::dvec2(p);
                 s[i] = snapToSubpixel(p.x, p.y);
                 w[i] = v[i]->position.w;
             }
             const glm::dvec3 inverseW = 1.0 / w;
+            // Coverage comes from the snapped (exact integer) edge functions; the weights
+            // for depth and attributes from the unsnapped positions, so snapping moves
+            // edges by at most 1/512 pixel but never tilts the interpolated plane.
+            auto cross = [](glm::dvec2 a, glm::dvec2 b) { return a.x * b.y - a.y * b.x; };
+            const double exactArea = cross(exact[1] - exact[0], exact[2] - exact[0]);
+            const bool useExact = std::abs(exactArea) > 1e-9;
             int64_t area = rasterizeTriangle(
                 s[0], s[1], s[2], width, height, settings.backfaceCulling,
-                [&](int x, int y, const glm::dvec3& screen) {
+                [&](int x, int y, glm::dvec3 screen) {
                     ++stats.fragments;
+                    if (useExact) {
+                        glm::dvec2 p(double(x) + 0.5, double(y) + 0.5);
+                        screen = glm::dvec3(cross(exact[2] - exact[1], p - exact[1]),
+                                            cross(exact[0] - exact[2], p - exact[2]),
+                                            cross(exact[1] - exact[0], p - exact[0])) /
+                                 exactArea;
+                    }
                     double depth = 1.0 / glm::dot(screen, inverseW);
                     size_t i = buffers.index(x, y);
-                    if (!depthTest(buffers.depth[i], float(depth))) return;
+                    if (!depthTest(buffers.depth[i], float(depth)) || settings.depthOnly) return;
                     glm::dvec3 l =
                         settings.perspectiveCorrect ? perspectiveCorrectWeights(screen, w) : screen;
                     glm::dvec3 original =
@@ -213,14 +227,22 @@ FrameStats rasterizeFrame(const RasterScene& scene, const Camera& camera,
                     buffers.weight1[i] = float(original.y);
                     buffers.weight2[i] = float(original.z);
                 });
-            drawn = drawn || area > 0 || (area < 0 && !settings.backfaceCulling);
+            drawn = drawn || area < 0 || (area > 0 && !settings.backfaceCulling);
         }
         if (drawn)
             ++stats.trianglesDrawn;
         else
             ++stats.culledBackface;
+    };
+    if (meshSubset) {
+        // The kept mesh triangles in file order, then everything else: the same order as
+        // the full frame, so z-buffer ties fall the same way.
+        for (uint32_t t : *meshSubset) draw(t);
+        for (size_t t = scene.meshTriangles; t < scene.triangles.size(); ++t) draw(t);
+    } else {
+        for (size_t t = 0; t < scene.triangles.size(); ++t) draw(t);
     }
-    for (uint32_t id : buffers.triangle) stats.pixelsCovered += id != kNoPrimitive;
+    for (float d : buffers.depth) stats.pixelsCovered += d != kInfinity<float>;
     stats.milliseconds = watch.milliseconds();
     return stats;
 }
@@ -242,6 +264,7 @@ ShadowMap buildShadowMap(const RasterScene& scene, const PointLight& light, int 
     c.aspect = 1.0f;
     RasterSettings settings;
     settings.width = settings.height = size;
+    settings.depthOnly = true;
     FrameBuffers buffers;
     rasterizeFrame(scene, c, settings, buffers);
     auto [near, far] = nearFarFor(scene, c, settings);
@@ -264,7 +287,7 @@ bool litByShadowMap(const ShadowMap& map, const Vec3& point, double bias) {
     // END SOLUTION
 }
 
-// EXERCISE 6.9: the hybrid: a shadow ray from the rasterized position through the scene (1 point)
+// EXERCISE 6.9: the hybrid: a shadow ray from the rasterized position (1 point)
 bool litByShadowRay(const Scene& scene, const Vec3& point, const Vec3& geometricNormal,
                     const PointLight& light) {
     // BEGIN SOLUTION

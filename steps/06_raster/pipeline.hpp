@@ -38,6 +38,7 @@ struct RasterSettings {
     bool backfaceCulling = false;
     bool perspectiveCorrect = true;  // false: affine weights (textures and normals warp)
     double guardBand = 64.0;         // clip |x|, |y| <= guardBand * w
+    bool depthOnly = false;          // only the depth buffer (a shadow map)
 };
 
 // Near and far planes for a view: the settings' own when given (checked: 0 < near < far),
@@ -53,7 +54,7 @@ struct FrameBuffers {
     std::vector<uint32_t> triangle;  // kNoPrimitive where nothing is drawn
     std::vector<float> depth;        // +infinity where nothing is drawn
     std::vector<float> weight1, weight2;
-    void reset(int w, int h);
+    void reset(int w, int h, bool depthOnly = false);
     size_t index(int x, int y) const { return size_t(y) * size_t(width) + size_t(x); }
 };
 
@@ -68,10 +69,11 @@ struct FrameStats {
     double milliseconds = 0.0;
 };
 
-// Draws triangles [first, last) of the scene (all when last == 0) into the buffers.
+// Draws every triangle into the buffers; with meshSubset, only those mesh triangles (in
+// increasing order, e.g. what frustum culling kept) and every non-mesh triangle.
 FrameStats rasterizeFrame(const RasterScene& scene, const Camera& camera,
-                          const RasterSettings& settings, FrameBuffers& buffers, size_t first = 0,
-                          size_t last = 0);
+                          const RasterSettings& settings, FrameBuffers& buffers,
+                          const std::vector<uint32_t>* meshSubset = nullptr);
 
 // A shadow map for one point light: the scene's depth seen from the light, through a
 // square perspective view aimed at the scene's bounds (Williams 1978).

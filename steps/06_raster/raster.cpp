@@ -6,27 +6,28 @@
 
 namespace boxes {
 
-// EXERCISE 6.1: view and projection matrices from the core's camera (glm::lookAt, glm::perspective)
-// (2 points)
-Mat4d viewMatrix(const Camera& camera) {
+// EXERCISE 6.1: view and projection matrices from the core's camera (GLM) (2 points)
+SpaceMatrices spaceMatrices(const Camera& camera, double near, double far) {
     // BEGIN SOLUTION
     // The camera's own basis, so a view direction parallel to up still gives a finite
     // matrix (the core picks another up then).
     CameraBasisT<float> b = camera.basis();
     glm::dvec3 eye(camera.eye);
-    return glm::lookAt(eye, eye + glm::dvec3(b.forward), glm::dvec3(b.up));
+    return {glm::lookAt(eye, eye + glm::dvec3(b.forward), glm::dvec3(b.up)),
+            glm::perspective(glm::radians(double(camera.fovYDegrees)), double(camera.aspect), near,
+                             far)};
     // END SOLUTION
+}
+
+Mat4d viewMatrix(const Camera& camera) {
+    return spaceMatrices(camera, 1.0, 2.0).view;
 }
 
 Mat4d projectionMatrix(const Camera& camera, double near, double far) {
-    // BEGIN SOLUTION
-    camera.validate();
-    return glm::perspective(glm::radians(double(camera.fovYDegrees)), double(camera.aspect), near,
-                            far);
-    // END SOLUTION
+    return spaceMatrices(camera, near, far).projection;
 }
 
-// EXERCISE 6.2: clip space to screen: perspective divide and viewport, row 0 at the top (1 point)
+// EXERCISE 6.2: clip space to screen: divide by w, viewport, row 0 at the top (1 point)
 glm::dvec3 clipToScreen(const Vec4d& clip, int width, int height) {
     // BEGIN SOLUTION
     glm::dvec3 ndc = glm::dvec3(clip) / clip.w;
@@ -34,8 +35,7 @@ glm::dvec3 clipToScreen(const Vec4d& clip, int width, int height) {
     // END SOLUTION
 }
 
-// EXERCISE 6.3: Sutherland-Hodgman: clip a convex polygon against one plane in clip space (3
-// points)
+// EXERCISE 6.3: Sutherland-Hodgman: clip a polygon against one plane in clip space (3 points)
 ClipPolygon clipAgainstPlane(const ClipPolygon& polygon, const Vec4d& plane) {
     // BEGIN SOLUTION
     ClipPolygon out;
@@ -66,8 +66,7 @@ int64_t edgeFunction(const FixedPoint2& a, const FixedPoint2& b, const FixedPoin
     // END SOLUTION
 }
 
-// EXERCISE 6.5: the top-left fill rule: which edges own the pixel centres lying exactly on them (2
-// points)
+// EXERCISE 6.5: the top-left fill rule: which edges own the pixel centres on them (2 points)
 bool isTopLeftEdge(const FixedPoint2& a, const FixedPoint2& b) {
     // BEGIN SOLUTION
     int64_t dx = b.x - a.x, dy = b.y - a.y;

@@ -20,6 +20,11 @@ using Mat4d = glm::dmat4;
 // GLM's default clip depth: the near plane maps to z/w = -1, the far plane to +1). Built
 // from the core's one camera model (eye, view direction, up, vertical field of view,
 // aspect ratio), so pixel centres match the ray tracer's primary rays.
+struct SpaceMatrices {
+    Mat4d view{1.0}, projection{1.0};
+};
+SpaceMatrices spaceMatrices(const Camera& camera, double near, double far);
+// The two parts of spaceMatrices.
 Mat4d viewMatrix(const Camera& camera);
 Mat4d projectionMatrix(const Camera& camera, double near, double far);
 
@@ -46,8 +51,8 @@ struct ClipPolygon {
 
 // A plane in homogeneous clip space: a point p is inside when dot(plane, p) >= 0.
 // The near plane with GLM's default depth is z + w >= 0; the far plane is w - z >= 0.
-constexpr Vec4d kNearPlane{0.0, 0.0, 1.0, 1.0};
-constexpr Vec4d kFarPlane{0.0, 0.0, -1.0, 1.0};
+constexpr Vec4d kClipNearPlane{0.0, 0.0, 1.0, 1.0};
+constexpr Vec4d kClipFarPlane{0.0, 0.0, -1.0, 1.0};
 // The guard band: |x| <= g w and |y| <= g w, so screen coordinates stay within g times the
 // image and fit the fixed-point edge functions; triangles inside the band are not clipped.
 inline std::array<Vec4d, 4> guardBandPlanes(double g) {
@@ -104,12 +109,14 @@ glm::dvec3 perspectiveCorrectWeights(const glm::dvec3& screen, const glm::dvec3&
 // The pixels a triangle covers: calls covered(x, y, screenWeights) for every pixel centre
 // inside the triangle under the top-left rule, within [0, width) x [0, height). The
 // vertices may come in either winding; zero area draws nothing. Returns the signed area
-// (twice, in fixed point) so callers can cull back faces before drawing.
+// (twice, in fixed point); with cullBackFaces a back face (E > 0, see below) draws nothing.
 template <typename Covered>
 int64_t rasterizeTriangle(FixedPoint2 v0, FixedPoint2 v1, FixedPoint2 v2, int width, int height,
-                          bool cullNegative, Covered&& covered) {
+                          bool cullBackFaces, Covered&& covered) {
     int64_t area = edgeFunction(v0, v1, v2);
-    if (area == 0 || (cullNegative && area < 0)) return area;
+    // A front face (counter-clockwise seen by the camera, the OBJ convention) turns clockwise
+    // on the y-down screen: E(v0, v1, v2) < 0. A back face has E > 0.
+    if (area == 0 || (cullBackFaces && area > 0)) return area;
     // Work on the positive winding; remember to swap the weights of vertices 1 and 2 back.
     bool swapped = area < 0;
     if (swapped) std::swap(v1, v2);

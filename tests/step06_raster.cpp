@@ -1,0 +1,726 @@
+// Step 06: the rasterizer's exercises with worked numbers, the rasterizer against the ray
+// tracer (generated scenes and real meshes), the shadows, the hard cases, and the program.
+#include <cmath>
+#include <cstring>
+#include <fstream>
+#include <glm/gtc/matrix_transform.hpp>
+#include <random>
+
+#include "06_raster/compare.hpp"
+#include "06_raster/culling.hpp"
+#include "06_raster/measure.hpp"
+#include "06_raster/pipeline.hpp"
+#include "06_raster/raster.hpp"
+#include "core/render.hpp"
+#include "support.hpp"
+
+using namespace boxes;
+using boxes::test::checkVec;
+
+namespace {
+
+Camera makeCamera(Vec3 eye, Vec3 look, Vec3 up, float fov, float aspect) {
+    Camera c;
+    c.eye = eye;
+    c.view = look - eye;
+    c.up = up;
+    c.fovYDegrees = fov;
+    c.aspect = aspect;
+    return c;
+}
+
+// Test-local fill-rule rasterizer: our own exact edge function, the student's top-left rule.
+int64_t localEdge(FixedPoint2 a, FixedPoint2 b, FixedPoint2 p) {
+    return (b.x - a.x) * (p.y - a.y) - (b.y - a.y) * (p.x - a.x);
+}
+void coverWithRule(FixedPoint2 v0, FixedPoint2 v1, FixedPoint2 v2, int width, int height,
+                   std::vector<int>& counts) {
+    int64_t area = localEdge(v0, v1, v2);
+    if (area == 0) return;
+    if (area < 0) std::swap(v1, v2);
+    for (int y = 0; y < height; ++y)
+        for (int x = 0; x < width; ++x) {
+            FixedPoint2 p = pixelCentre(x, y);
+            int64_t e0 = localEdge(v1, v2, p), e1 = localEdge(v2, v0, p), e2 = localEdge(v0, v1, p);
+            bool in0 = e0 > 0 || (e0 == 0 && isTopLeftEdge(v1, v2));
+            bool in1 = e1 > 0 || (e1 == 0 && isTopLeftEdge(v2, v0));
+            bool in2 = e2 > 0 || (e2 == 0 && isTopLeftEdge(v0, v1));
+            if (in0 && in1 && in2) ++counts[size_t(y * width + x)];
+        }
+}
+
+// A pixel position in fixed point from whole and half pixels.
+FixedPoint2 at(double x, double y) {
+    return snapToSubpixel(x, y);
+}
+
+// A bumpy closed-ish terrain and a few loose triangles: a generated scene for agreement.
+Scene generatedScene(uint64_t seed) {
+    Scene s;
+    s.name = "generated";
+    std::mt19937_64 rng(seed);
+    std::uniform_real_distribution<float> u(-1.0f, 1.0f);
+    const int n = 24;
+    for (int j = 0; j <= n; ++j)
+        for (int i = 0; i <= n; ++i) {
+            float x = -2.0f + 4.0f * float(i) / n, z = -2.0f + 4.0f * float(j) / n;
+            s.mesh.positions.push_back(
+                Vec3(x, 0.15f * std::sin(3.0f * x) * std::cos(2.0f * z) + 0.03f * u(rng), z));
+        }
+    for (int j = 0; j < n; ++j)
+        for (int i = 0; i < n; ++i) {
+            uint32_t a = uint32_t(j * (n + 1) + i), b = a + 1, c = a + uint32_t(n + 1), d = c + 1;
+            s.mesh.triangles.push_back({a, c, b});
+            s.mesh.triangles.push_back({b, c, d});
+        }
+    for (int k = 0; k < 40; ++k) {
+        uint32_t base = uint32_t(s.mesh.positions.size());
+        Vec3 centre(1.5f * u(rng), 0.6f + 0.4f * u(rng), 1.5f * u(rng));
+        for (int v = 0; v < 3; ++v)
+            s.mesh.positions.push_back(centre + 0.35f * Vec3(u(rng), u(rng), u(rng)));
+        s.mesh.triangles.push_back({base, base + 1, base + 2});
+    }
+    s.mesh.computeVertexNormals();
+    s.lights.push_back({Vec3(1.0f, 4.0f, 2.0f), Vec3(30.0f), kInfinity<float>});
+    attachGrid(s);
+    return s;
+}
+
+struct Agreement {
+    VisibilityComparison visibility;
+    FrameStats stats;
+};
+Agreement agreementOf(const Scene& scene, const Camera& camera, int width, int height,
+                      RasterSettings settings = {}) {
+    RasterScene raster = RasterScene::fromScene(scene);
+    settings.width = width;
+    settings.height = height;
+    FrameBuffers buffers;
+    Agreement a;
+    a.stats = rasterizeFrame(raster, camera, settings, buffers);
+    TracedFrame traced = traceFrame(scene, camera, width, height, false, 0);
+    a.visibility =
+        compareVisibility(width, height, meshIds(raster, buffers), meshDepths(raster, buffers),
+                          traced.ids, traced.depth, &scene.mesh);
+    return a;
+}
+
+void checkAgreement(const Agreement& a, double minimum) {
+    const VisibilityComparison& c = a.visibility;
+    INFO("covered raster " << c.coveredRaster << ", traced " << c.coveredTraced << ", same "
+                           << c.sameTriangle << " of " << c.coveredEither << ", on edges "
+                           << c.differOnEdge << ", elsewhere " << c.differElsewhere);
+    CHECK(c.agreement() >= minimum);
+    CHECK(c.coverageDifference() < 0.002);
+    CHECK(c.maxDepthError < 1e-3);
+}
+
+}  // namespace
+
+TEST_SUITE("exercise 6.1") {
+    TEST_CASE("a point through view and clip space") {
+        // Eye (0,0,5) looking down -z, fov 90 (f = 1), aspect 2, near 1, far 11.
+        Camera c = makeCamera(Vec3(0, 0, 5), Vec3(0, 0, 0), Vec3(0, 1, 0), 90.0f, 2.0f);
+        Vec4d view = viewMatrix(c) * Vec4d(1.0, 0.5, 0.0, 1.0);
+        checkVec(view, Vec4d(1.0, 0.5, -5.0, 1.0), 1e-12);
+        CHECK(view.w == doctest::Approx(1.0));
+        Vec4d clip = projectionMatrix(c, 1.0, 11.0) * view;
+        // x: f/aspect * 1 = 0.5; y: f * 0.5; z: (12/10) 5 - 22/10 = 3.8; w = 5.
+        checkVec(clip, Vec4d(0.5, 0.5, 3.8, 5.0), 1e-6);
+        CHECK(clip.w == doctest::Approx(5.0).epsilon(1e-12));
+        // GLM's default clip depth: the near plane at z/w = -1, the far plane at +1.
+        Vec4d near = projectionMatrix(c, 1.0, 11.0) * Vec4d(0, 0, -1, 1);
+        Vec4d far = projectionMatrix(c, 1.0, 11.0) * Vec4d(0, 0, -11, 1);
+        CHECK(near.z / near.w == doctest::Approx(-1.0));
+        CHECK(far.z / far.w == doctest::Approx(1.0));
+    }
+    TEST_CASE("pixel centres land where the ray tracer's primary rays go") {
+        Camera c =
+            makeCamera(Vec3(0.3f, 1.2f, 4.0f), Vec3(-0.2f, 0.1f, 0.0f), Vec3(0, 1, 0), 50.0f, 1.5f);
+        const int w = 90, h = 60;
+        Mat4d m = projectionMatrix(c, 0.01, 100.0) * viewMatrix(c);
+        for (auto [x, y] : {std::pair{0, 0}, {89, 59}, {45, 30}, {3, 57}}) {
+            Vec3 d = c.directionThrough(float(x) + 0.5f, float(y) + 0.5f, w, h);
+            Vec4d clip = m * Vec4d(glm::dvec3(c.eye + 3.0f * d), 1.0);
+            // The viewport, test-local: row 0 at the top.
+            double sx = (clip.x / clip.w + 1.0) * 0.5 * w, sy = (1.0 - clip.y / clip.w) * 0.5 * h;
+            CHECK(sx == doctest::Approx(x + 0.5).epsilon(1e-5));
+            CHECK(sy == doctest::Approx(y + 0.5).epsilon(1e-5));
+            CHECK(clip.w == doctest::Approx(3.0 * glm::dot(d, c.basis().forward)).epsilon(1e-5));
+        }
+    }
+    TEST_CASE("hard case: view parallel to up gives a finite view matrix") {
+        Camera c = makeCamera(Vec3(0, 5, 0), Vec3(0, 0, 0), Vec3(0, 1, 0), 60.0f, 1.0f);
+        Mat4d v = viewMatrix(c);
+        for (int i = 0; i < 4; ++i)
+            for (int j = 0; j < 4; ++j) CHECK(std::isfinite(v[i][j]));
+        Vec4d p = v * Vec4d(0, 0, 0, 1);
+        checkVec(p, Vec4d(0, 0, -5, 1), 1e-6);
+    }
+}
+
+TEST_SUITE("exercise 6.2") {
+    TEST_CASE("clip to screen: divide by w and the viewport with row 0 at the top") {
+        glm::dvec3 s = clipToScreen(Vec4d(0.5, 0.5, 3.8, 5.0), 8, 4);
+        checkVec(s, glm::dvec3(4.4, 1.8, 0.76), 1e-12);
+        checkVec(clipToScreen(Vec4d(-2, 2, 0, 2), 8, 4), glm::dvec3(0, 0, 0),
+                 1e-12);  // top-left corner
+        checkVec(clipToScreen(Vec4d(3, -3, 3, 3), 8, 4), glm::dvec3(8, 4, 1),
+                 1e-12);  // bottom-right
+    }
+}
+
+TEST_SUITE("exercise 6.3") {
+    ClipPolygon triangle(Vec4d a, Vec4d b, Vec4d c) {
+        ClipPolygon p;
+        p.add({a, {1, 0, 0}});
+        p.add({b, {0, 1, 0}});
+        p.add({c, {0, 0, 1}});
+        return p;
+    }
+    TEST_CASE("a triangle crossing the near plane becomes a quad with the new vertices") {
+        // a is outside (z + w = -1), b and c inside (z + w = 1).
+        ClipPolygon out =
+            clipAgainstPlane(triangle({0, 0, -2, 1}, {0, 0, 0, 1}, {1, 0, 0, 1}), kClipNearPlane);
+        REQUIRE(out.count == 4);
+        checkVec(out.vertices[0].position, Vec4d(0, 0, -1, 1), 1e-15);
+        checkVec(out.vertices[0].weights, glm::dvec3(0.5, 0.5, 0), 1e-15);
+        checkVec(out.vertices[1].position, Vec4d(0, 0, 0, 1), 0.0);
+        checkVec(out.vertices[2].position, Vec4d(1, 0, 0, 1), 0.0);
+        checkVec(out.vertices[3].position, Vec4d(0.5, 0, -1, 1), 1e-15);
+        checkVec(out.vertices[3].weights, glm::dvec3(0.5, 0, 0.5), 1e-15);
+        CHECK(out.vertices[3].position.w == 1.0);
+    }
+    TEST_CASE(
+        "one vertex inside: a smaller triangle; all inside: unchanged; all outside: nothing") {
+        ClipPolygon one =
+            clipAgainstPlane(triangle({0, 0, 0, 1}, {0, 0, -3, 1}, {1, 0, -3, 1}), kClipNearPlane);
+        REQUIRE(one.count == 3);
+        for (int i = 0; i < 3; ++i)
+            CHECK(glm::dot(kClipNearPlane, one.vertices[size_t(i)].position) >= -1e-15);
+        ClipPolygon all =
+            clipAgainstPlane(triangle({0, 0, 0, 1}, {1, 0, 0, 1}, {0, 1, 0, 1}), kClipNearPlane);
+        CHECK(all.count == 3);
+        ClipPolygon none =
+            clipAgainstPlane(triangle({0, 0, -2, 1}, {1, 0, -2, 1}, {0, 1, -2, 1}), kClipNearPlane);
+        CHECK(none.count == 0);
+    }
+    TEST_CASE("hard case: a triangle through w = 0 keeps only its part in front of the eye") {
+        // One vertex behind the eye (w < 0); after clipping every w is positive, so the
+        // divide by w cannot wrap the triangle around or flip it.
+        Mat4d p = glm::perspective(glm::radians(90.0), 1.0, 0.1, 100.0);
+        ClipPolygon out = clipAgainstPlane(
+            triangle(p * Vec4d(-1, -1, -2, 1), p * Vec4d(1, -1, -2, 1), p * Vec4d(0, -1, 3, 1)),
+            kClipNearPlane);
+        REQUIRE(out.count == 4);
+        for (int i = 0; i < out.count; ++i)
+            CHECK(out.vertices[size_t(i)].position.w >= 0.1 - 1e-12);
+    }
+    TEST_CASE("hard case: two triangles sharing a clipped edge get the same new vertex") {
+        Vec4d a(0.3, 0.1, -3.0, 1.7), b(-0.4, 0.2, 2.0, 2.5), c(1, 1, 1, 2), d(-1, 2, 1, 2);
+        ClipPolygon first = clipAgainstPlane(triangle(a, b, c), kClipNearPlane);
+        ClipPolygon second = clipAgainstPlane(triangle(b, a, d), kClipNearPlane);
+        // The new vertex on the shared edge: weights only on its two ends.
+        auto onEdge = [&](const ClipPolygon& p) {
+            for (int i = 0; i < p.count; ++i) {
+                glm::dvec3 w = p.vertices[size_t(i)].weights;
+                if (w.z == 0.0 && w.x > 0.0 && w.y > 0.0) return p.vertices[size_t(i)].position;
+            }
+            return Vec4d(NAN);
+        };
+        Vec4d p1 = onEdge(first), p2 = onEdge(second);
+        CHECK(p1 == p2);  // bit for bit
+    }
+}
+
+TEST_SUITE("exercise 6.4") {
+    TEST_CASE("edge function: side and twice the signed area") {
+        FixedPoint2 a{0, 0}, b{4, 0}, c{0, 4}, p{1, 3};
+        CHECK(edgeFunction(a, b, p) == 12);
+        CHECK(edgeFunction(b, a, p) == -12);
+        CHECK(edgeFunction(a, b, c) == 16);
+        CHECK(edgeFunction(a, b, FixedPoint2{7, 0}) == 0);
+        CHECK(edgeFunction(a, b, FixedPoint2{1, -2}) == -8);
+    }
+    TEST_CASE("hard case: exactly opposite on a shared edge far from the origin") {
+        FixedPoint2 a{123456789, -98765432}, b{-23456789, 87654321};
+        std::mt19937_64 rng(3);
+        std::uniform_int_distribution<int64_t> u(-200000000, 200000000);
+        for (int i = 0; i < 1000; ++i) {
+            FixedPoint2 p{u(rng), u(rng)};
+            CHECK(edgeFunction(a, b, p) == -edgeFunction(b, a, p));
+        }
+    }
+}
+
+TEST_SUITE("exercise 6.5") {
+    TEST_CASE("top and left edges of a clockwise triangle on a y-down screen") {
+        FixedPoint2 a{0, 0}, b{4, 0}, c{0, 4};
+        CHECK(isTopLeftEdge(a, b));        // horizontal, to +x: top
+        CHECK_FALSE(isTopLeftEdge(b, c));  // runs down: right
+        CHECK(isTopLeftEdge(c, a));        // runs up: left
+        CHECK_FALSE(isTopLeftEdge(b, a));  // horizontal, to -x: bottom
+    }
+    TEST_CASE("two triangles sharing an edge through pixel centres: every pixel exactly once") {
+        // A square split along its diagonal, corners on pixel centres: the diagonal and the
+        // square's sides pass through pixel centres.
+        const int w = 12, h = 12;
+        std::vector<int> counts(size_t(w * h), 0);
+        FixedPoint2 a = at(1.5, 1.5), b = at(9.5, 1.5), c = at(9.5, 9.5), d = at(1.5, 9.5);
+        coverWithRule(a, b, c, w, h, counts);
+        coverWithRule(a, c, d, w, h, counts);
+        int covered = 0;
+        for (int y = 0; y < h; ++y)
+            for (int x = 0; x < w; ++x) {
+                int n = counts[size_t(y * w + x)];
+                CHECK(n <= 1);
+                covered += n;
+                bool interior = x >= 2 && x <= 8 && y >= 2 && y <= 8;
+                if (interior) CHECK(n == 1);
+            }
+        // The top and left sides belong to the square, the bottom and right do not: 8 x 8.
+        CHECK(covered == 64);
+    }
+    TEST_CASE("a fan of triangles around one vertex: every covered pixel exactly once") {
+        const int w = 24, h = 24;
+        std::vector<int> counts(size_t(w * h), 0);
+        FixedPoint2 centre = at(12.5, 12.5);
+        // 12 fan triangles with rim vertices on pixel centres, both windings mixed.
+        std::vector<FixedPoint2> rim = {at(20.5, 12.5), at(19.5, 17.5), at(16.5, 20.5),
+                                        at(12.5, 21.5), at(7.5, 19.5),  at(4.5, 16.5),
+                                        at(3.5, 12.5),  at(4.5, 7.5),   at(8.5, 4.5),
+                                        at(12.5, 3.5),  at(17.5, 4.5),  at(20.5, 8.5)};
+        for (size_t i = 0; i < rim.size(); ++i) {
+            FixedPoint2 p = rim[i], q = rim[(i + 1) % rim.size()];
+            if (i % 2)
+                coverWithRule(centre, p, q, w, h, counts);
+            else
+                coverWithRule(q, centre, p, w, h, counts);
+        }
+        // Strictly inside the rim polygon: exactly once; anywhere: at most once.
+        for (int y = 0; y < h; ++y)
+            for (int x = 0; x < w; ++x) {
+                FixedPoint2 p = pixelCentre(x, y);
+                bool strictlyInside = true;
+                for (size_t i = 0; i < rim.size(); ++i)
+                    strictlyInside =
+                        strictlyInside && localEdge(rim[i], rim[(i + 1) % rim.size()], p) < 0;
+                int n = counts[size_t(y * w + x)];
+                INFO("pixel " << x << "," << y);
+                CHECK(n <= 1);
+                if (strictlyInside) CHECK(n == 1);
+            }
+        CHECK(counts[size_t(12 * w + 12)] == 1);  // the shared vertex's pixel
+    }
+}
+
+TEST_SUITE("exercise 6.6") {
+    TEST_CASE("z-buffer: nearer wins and a tie keeps the first") {
+        float stored = kInfinity<float>;
+        CHECK(depthTest(stored, 2.0f));
+        CHECK(stored == 2.0f);
+        CHECK_FALSE(depthTest(stored, 2.0f));  // the tie: the first triangle keeps the pixel
+        CHECK_FALSE(depthTest(stored, 3.0f));
+        CHECK(depthTest(stored, 1.0f));
+        CHECK(stored == 1.0f);
+        CHECK_FALSE(depthTest(stored, NAN));
+        CHECK(stored == 1.0f);
+    }
+}
+
+TEST_SUITE("exercise 6.7") {
+    TEST_CASE("perspective-correct weights: worked numbers") {
+        // Screen weights 1/3 each, w = 1, 2, 4: (1/3, 1/6, 1/12) / (7/12) = (4/7, 2/7, 1/7).
+        glm::dvec3 l = perspectiveCorrectWeights(glm::dvec3(1.0 / 3.0), glm::dvec3(1, 2, 4));
+        checkVec(l, glm::dvec3(4.0 / 7.0, 2.0 / 7.0, 1.0 / 7.0), 1e-15);
+        // Equal w: the screen weights themselves.
+        checkVec(perspectiveCorrectWeights(glm::dvec3(0.2, 0.3, 0.5), glm::dvec3(3.0)),
+                 glm::dvec3(0.2, 0.3, 0.5), 1e-15);
+    }
+    TEST_CASE("a known attribute: the 3D barycentrics of a projected point are recovered") {
+        // Camera-space vertices (looking down -z), w = -z; the point P = 0.2 A + 0.3 B + 0.5 C.
+        glm::dvec3 A(-1, -1, -2), B(1, -1, -4), C(0, 1, -8);
+        glm::dvec3 P = 0.2 * A + 0.3 * B + 0.5 * C;
+        auto project = [](glm::dvec3 p) { return glm::dvec2(p.x / -p.z, p.y / -p.z); };
+        glm::dvec2 a = project(A), b = project(B), c = project(C), p = project(P);
+        auto cross = [](glm::dvec2 u, glm::dvec2 v) { return u.x * v.y - u.y * v.x; };
+        double area = cross(b - a, c - a);
+        glm::dvec3 screen(cross(c - b, p - b) / area, cross(a - c, p - c) / area,
+                          cross(b - a, p - a) / area);
+        glm::dvec3 l = perspectiveCorrectWeights(screen, glm::dvec3(2, 4, 8));
+        checkVec(l, glm::dvec3(0.2, 0.3, 0.5), 1e-12);
+        // The affine (screen) weights are not the 3D ones: that is the warp.
+        CHECK(std::abs(screen.x - 0.2) > 0.05);
+    }
+}
+
+TEST_SUITE("exercise 6.8") {
+    TEST_CASE("shadow map lookup: in front lit and behind shadowed and the bias") {
+        ShadowMap map;
+        map.size = 2;
+        map.viewProjection =
+            glm::perspective(glm::radians(90.0), 1.0, 1.0, 100.0);  // light at 0 looking down -z
+        map.depth = {kInfinity<float>, 5.0f, kInfinity<float>, kInfinity<float>};
+        // (0.5, 0.5, -4): w = 4, screen (1.125, 0.875): texel (1, 0), stored depth 5.
+        CHECK(litByShadowMap(map, Vec3(0.5f, 0.5f, -4.0f), 0.0));
+        CHECK_FALSE(litByShadowMap(map, Vec3(1.25f, 1.25f, -10.0f), 0.0));  // w = 10 behind 5
+        CHECK(litByShadowMap(map, Vec3(1.25f, 1.25f, -10.0f), 6.0));        // 10 - 6 <= 5
+        CHECK_FALSE(litByShadowMap(map, Vec3(1.25f, 1.25f, -10.0f), 4.0));
+        CHECK(litByShadowMap(map, Vec3(-1.0f, 1.0f, -10.0f), 0.0));  // an empty texel
+        CHECK(litByShadowMap(map, Vec3(0.5f, 0.5f, 4.0f), 0.0));     // behind the light
+        CHECK(litByShadowMap(map, Vec3(50.0f, 0.5f, -4.0f), 0.0));   // outside the map
+    }
+}
+
+TEST_SUITE("exercise 6.9") {
+    TEST_CASE("hybrid shadow ray: an occluder between the point and the light") {
+        Scene s;
+        s.lights.push_back({Vec3(0, 10, 0), Vec3(100.0f), kInfinity<float>});
+        const PointLight& light = s.lights[0];
+        CHECK(litByShadowRay(s, Vec3(0, 0, 0), Vec3(0, 1, 0), light));
+        s.spheres.push_back({{Vec3(0, 5, 0), 1.0f}, 0});
+        CHECK_FALSE(litByShadowRay(s, Vec3(0, 0, 0), Vec3(0, 1, 0), light));
+        CHECK(litByShadowRay(s, Vec3(3, 0, 0), Vec3(0, 1, 0), light));
+        // A point on a floor plane does not shadow itself (the origin is offset).
+        s.planes.push_back({{Vec3(0, 1, 0), 0.0f}, 0});
+        CHECK(litByShadowRay(s, Vec3(3, 0, 0), Vec3(0, 1, 0), light));
+        // The light beyond the sphere only counts up to the light: a sphere behind it does not.
+        CHECK(litByShadowRay(s, Vec3(0, 7, 0), Vec3(0, 1, 0), light));
+    }
+}
+
+TEST_SUITE("raster vs ray tracer") {
+    TEST_CASE("generated scenes from several views agree on at least 99.5 percent") {
+        Scene s = generatedScene(7);
+        for (const Camera& c :
+             {makeCamera(Vec3(0, 2.5f, 4), Vec3(0, 0, 0), Vec3(0, 1, 0), 50.0f, 4.0f / 3.0f),
+              makeCamera(Vec3(-3, 0.7f, 0.2f), Vec3(2, 0.2f, 0), Vec3(0, 1, 0), 70.0f, 4.0f / 3.0f),
+              makeCamera(Vec3(0.1f, 0.4f, 0.1f), Vec3(1, 0.3f, 1), Vec3(0, 1, 0), 90.0f,
+                         4.0f / 3.0f)}) {
+            Agreement a = agreementOf(s, c, 160, 120);
+            CHECK(a.visibility.coveredEither > 1000);
+            checkAgreement(a, 0.995);
+        }
+    }
+    TEST_CASE("the bunny from outside agrees on at least 99.5 percent") {
+        Scene s = makeScene("bunny", {test::dataDir(), 4.0f / 3.0f});
+        attachGrid(s);
+        Agreement a = agreementOf(s, s.camera, 200, 150);
+        CHECK(a.visibility.coveredEither > 4000);
+        checkAgreement(a, 0.995);
+        CHECK(a.visibility.differElsewhere <= a.visibility.differOnEdge);
+    }
+    TEST_CASE("oa_thor from inside agrees on at least 99.5 percent when the shared meshes exist") {
+        std::string shared = findSharedMeshes(test::dataDir());
+        if (shared.empty()) {
+            MESSAGE("../shared/data/meshes not found: skipped");
+            return;
+        }
+        Scene s = makeScene(shared + "/oa_thor.obj", {test::dataDir(), 4.0f / 3.0f});
+        attachGrid(s);
+        Camera c =
+            makeCamera(Vec3(960, -384, 2), Vec3(960, 600, 2), Vec3(0, 0, 1), 90.0f, 4.0f / 3.0f);
+        Agreement a = agreementOf(s, c, 200, 150);
+        checkAgreement(a, 0.995);
+        // Most of the map lies behind the eye or crosses the near plane.
+        CHECK(a.stats.culledOutside + a.stats.clipped > a.stats.trianglesIn / 4);
+    }
+    TEST_CASE("back-face culling changes nothing on a closed mesh seen from outside") {
+        Scene s = makeScene("sh1", {test::dataDir(), 4.0f / 3.0f});
+        RasterScene raster = RasterScene::fromScene(s);
+        RasterSettings rs;
+        rs.width = 120;
+        rs.height = 90;
+        FrameBuffers all, culled;
+        rasterizeFrame(raster, s.camera, rs, all);
+        rs.backfaceCulling = true;
+        FrameStats stats = rasterizeFrame(raster, s.camera, rs, culled);
+        size_t differ = 0, emptied = 0;
+        for (size_t i = 0; i < all.triangle.size(); ++i) {
+            differ += all.triangle[i] != culled.triangle[i];
+            emptied += all.triangle[i] != kNoPrimitive && culled.triangle[i] == kNoPrimitive;
+        }
+        INFO("differ " << differ << " emptied " << emptied);
+        CHECK(all.triangle == culled.triangle);
+        CHECK(stats.culledBackface > raster.meshTriangles / 4);
+    }
+}
+
+TEST_SUITE("hard cases 06") {
+    TEST_CASE("hard case: view direction parallel to up still renders and agrees") {
+        Scene s = generatedScene(2);
+        Camera c = makeCamera(Vec3(0, 5, 0), Vec3(0, 0, 0), Vec3(0, 1, 0), 60.0f, 1.0f);
+        Agreement a = agreementOf(s, c, 80, 80);
+        CHECK(a.visibility.coveredEither > 1000);
+        // Seen straight from above, the terrain's grid lines run through pixel centres:
+        // the fill rule and the ray tracer's watertight test may then break the ties on
+        // edges differently, so this view agrees a little less, and only on edges.
+        checkAgreement(a, 0.98);
+        CHECK(a.visibility.differElsewhere == 0);
+    }
+    TEST_CASE("hard case: a large triangle passing behind the eye is not wrapped or flipped") {
+        Scene s;
+        s.name = "behind";
+        s.mesh.positions = {
+            {-50, -1, 10}, {50, -1, 10}, {0, -1, -50}};  // a floor through the eye's feet
+        s.mesh.triangles = {{0, 1, 2}};
+        s.mesh.computeVertexNormals();
+        attachGrid(s);
+        Camera c = makeCamera(Vec3(0, 0, 0), Vec3(0, -0.3f, -1), Vec3(0, 1, 0), 80.0f, 1.0f);
+        Agreement a = agreementOf(s, c, 64, 64);
+        CHECK(a.stats.clipped == 1);
+        CHECK(a.visibility.coveredRaster > 1000);
+        checkAgreement(a, 0.995);
+    }
+    TEST_CASE("hard case: degenerate and sub-pixel triangles draw nothing or the right pixel") {
+        int drawn = 0;
+        auto count = [&](int, int, const glm::dvec3& l) {
+            ++drawn;
+            CHECK(std::isfinite(l.x + l.y + l.z));
+        };
+        // Zero area: three collinear points, and a repeated vertex.
+        CHECK(rasterizeTriangle(at(1, 1), at(5, 5), at(9, 9), 16, 16, false, count) == 0);
+        CHECK(rasterizeTriangle(at(1, 1), at(1, 1), at(9, 2), 16, 16, false, count) == 0);
+        CHECK(drawn == 0);
+        // A sub-pixel triangle around the centre of pixel (3, 4) covers exactly it.
+        std::vector<std::pair<int, int>> pixels;
+        rasterizeTriangle(at(3.4, 4.4), at(3.7, 4.4), at(3.5, 4.7), 16, 16, false,
+                          [&](int x, int y, const glm::dvec3&) {
+                              pixels.push_back({x, y});
+                          });
+        CHECK(pixels == std::vector<std::pair<int, int>>{{3, 4}});
+        // One that misses every centre draws nothing.
+        pixels.clear();
+        rasterizeTriangle(at(3.6, 4.6), at(3.9, 4.6), at(3.7, 4.9), 16, 16, false,
+                          [&](int x, int y, const glm::dvec3&) {
+                              pixels.push_back({x, y});
+                          });
+        CHECK(pixels.empty());
+    }
+    TEST_CASE("hard case: duplicate triangles tie in the z-buffer and the first one wins") {
+        Scene s;
+        s.name = "duplicates";
+        s.mesh.positions = {{-1, -1, 0}, {1, -1, 0}, {0, 1, 0}};
+        s.mesh.triangles = {{0, 1, 2}, {0, 1, 2}};
+        s.mesh.computeVertexNormals();
+        RasterScene raster = RasterScene::fromScene(s);
+        RasterSettings rs;
+        rs.width = rs.height = 32;
+        FrameBuffers b;
+        Camera c = makeCamera(Vec3(0, 0, 3), Vec3(0, 0, 0), Vec3(0, 1, 0), 60.0f, 1.0f);
+        FrameStats stats = rasterizeFrame(raster, c, rs, b);
+        CHECK(stats.pixelsCovered > 50);
+        for (uint32_t id : b.triangle) CHECK((id == kNoPrimitive || id == 0));
+    }
+    TEST_CASE("hard case: a mesh with a NaN coordinate is refused with a clear message") {
+        Scene s;
+        s.name = "nan";
+        s.mesh.positions = {{0, 0, 0}, {1, NAN, 0}, {0, 1, 0}};
+        s.mesh.triangles = {{0, 1, 2}};
+        CHECK_THROWS_WITH_AS(RasterScene::fromScene(s), doctest::Contains("vertex 2"), InputError);
+    }
+    TEST_CASE("hard case: near and far are checked") {
+        Scene s = generatedScene(1);
+        RasterScene raster = RasterScene::fromScene(s);
+        Camera c = makeCamera(Vec3(0, 2, 4), Vec3(0, 0, 0), Vec3(0, 1, 0), 60.0f, 1.0f);
+        RasterSettings rs;
+        rs.near = -1.0;
+        CHECK_THROWS_AS(nearFarFor(raster, c, rs), InputError);
+        rs.near = 2.0;
+        rs.far = 1.0;
+        CHECK_THROWS_AS(nearFarFor(raster, c, rs), InputError);
+        rs.far = 0.0;
+        auto [n, f] = nearFarFor(raster, c, rs);
+        CHECK(n == 2.0);
+        CHECK(f > n);
+    }
+}
+
+TEST_SUITE("shadows 06") {
+    TEST_CASE("the hybrid's shadow rays match the ray tracer's shadows") {
+        Scene s = makeScene("bunny", {test::dataDir(), 4.0f / 3.0f});
+        attachGrid(s);
+        RasterScene raster = RasterScene::fromScene(s);
+        RasterSettings rs;
+        rs.width = 160;
+        rs.height = 120;
+        FrameBuffers b;
+        rasterizeFrame(raster, s.camera, rs, b);
+        TracedFrame traced = traceFrame(s, s.camera, rs.width, rs.height, true, 0);
+        ShadeSettings ss;
+        ss.shadows = ShadowMode::Rays;
+        ShadedFrame f = shadeFrame(s, raster, s.camera, b, ss);
+        ShadowComparison c = compareShadows(meshIds(raster, b), f.litByFirstLight, traced.ids,
+                                            traced.litByFirstLight);
+        CHECK(c.compared > 2500);
+        CHECK(c.disagreement() < 0.002);
+    }
+    TEST_CASE("the shadow map: acne without bias and peter-panning with too much") {
+        Scene s = makeScene("bunny", {test::dataDir(), 4.0f / 3.0f});
+        attachGrid(s);
+        RasterScene raster = RasterScene::fromScene(s);
+        RasterSettings rs;
+        rs.width = 160;
+        rs.height = 120;
+        FrameBuffers b;
+        rasterizeFrame(raster, s.camera, rs, b);
+        TracedFrame traced = traceFrame(s, s.camera, rs.width, rs.height, true, 0);
+        std::vector<ShadowMap> maps{buildShadowMap(raster, s.lights[0], 1024)};
+        auto compareAt = [&](double relativeBias) {
+            ShadeSettings ss;
+            ss.shadows = ShadowMode::Map;
+            ss.mapBias = relativeBias * double(raster.diagonal());
+            ShadedFrame f = shadeFrame(s, raster, s.camera, b, ss, &maps);
+            return compareShadows(meshIds(raster, b), f.litByFirstLight, traced.ids,
+                                  traced.litByFirstLight);
+        };
+        ShadowComparison none = compareAt(1e-12), good = compareAt(2e-3), large = compareAt(5e-2);
+        INFO("acne " << none.acne << " / " << good.acne << " / " << large.acne << ", leaks "
+                     << none.leaks << " / " << good.leaks << " / " << large.leaks);
+        CHECK(none.acne > 5 * (good.acne + 1));
+        CHECK(large.leaks > 2 * (good.leaks + 1));
+        CHECK(good.disagreement() < 0.03);
+    }
+}
+
+TEST_SUITE("frustum culling 06") {
+    void checkCulledIdentical(const Scene& s, const Camera& c) {
+        RasterScene raster = RasterScene::fromScene(s);
+        FrustumCuller culler(s.mesh);
+        RasterSettings rs;
+        rs.width = 160;
+        rs.height = 120;
+        FrameBuffers all, culled;
+        CullStats none, cull;
+        FrameStats full = rasterizeCulled(raster, nullptr, c, rs, all, none);
+        for (CullTest test : {CullTest::Planes, CullTest::PlanesAndCorners}) {
+            FrameStats stats = rasterizeCulled(raster, &culler, c, rs, culled, cull, test);
+            INFO("boxes culled " << cull.boxesCulled << " kept " << cull.boxesKept
+                                 << ", triangles kept " << cull.trianglesKept << " of "
+                                 << raster.meshTriangles);
+            CHECK(cull.boxesCulled > 0);
+            CHECK(cull.boxesVisited == cull.boxesCulled + cull.boxesKept);
+            CHECK(cull.trianglesKept < raster.meshTriangles);
+            CHECK(stats.trianglesIn < full.trianglesIn);
+            CHECK(stats.pixelsCovered == full.pixelsCovered);
+            CHECK(culled.triangle == all.triangle);
+            CHECK(culled.depth == all.depth);
+            CHECK(culled.weight1 == all.weight1);
+            CHECK(culled.weight2 == all.weight2);
+        }
+    }
+    TEST_CASE("the culled render is identical to the unculled one: bunny close-up") {
+        Scene s = makeScene("bunny", {test::dataDir(), 4.0f / 3.0f});
+        checkCulledIdentical(s, makeCamera(Vec3(-0.35f, 0.55f, 0.9f), Vec3(-0.45f, 0.5f, 0.0f),
+                                           Vec3(0, 1, 0), 40.0f, 4.0f / 3.0f));
+    }
+    TEST_CASE("the culled render is identical to the unculled one: inside a generated scene") {
+        Scene s = generatedScene(5);
+        checkCulledIdentical(s, makeCamera(Vec3(0.0f, 0.5f, 0.0f), Vec3(1.0f, 0.3f, 0.2f),
+                                           Vec3(0, 1, 0), 60.0f, 4.0f / 3.0f));
+    }
+}
+
+TEST_SUITE("program 06") {
+    const std::string program = BOXES_PROGRAM;
+
+    TEST_CASE("headless render writes a PNG and the ids and depth buffers") {
+        test::TempDir dir;
+        auto run = test::runProgram(
+            program,
+            "--headless --scene sh1 --width 64 --height 40 --out a.png --ids a.ids "
+            "--depth a.depth --json",
+            dir);
+        INFO(run.err);
+        REQUIRE(run.exitCode == 0);
+        CHECK(test::pngSize(dir.file("a.png")) == std::pair{64, 40});
+        std::string ids = test::readText(dir.file("a.ids")),
+                    depth = test::readText(dir.file("a.depth"));
+        REQUIRE(ids.size() == 64 * 40 * 4);
+        REQUIRE(depth.size() == 64 * 40 * 4);
+        size_t covered = 0;
+        for (size_t i = 0; i < 64 * 40; ++i) {
+            uint32_t id;
+            float d;
+            std::memcpy(&id, ids.data() + 4 * i, 4);
+            std::memcpy(&d, depth.data() + 4 * i, 4);
+            CHECK((id == kNoPrimitive) == std::isinf(d));
+            if (id != kNoPrimitive) {
+                ++covered;
+                CHECK(id < 3290u);
+                CHECK(d > 0.0f);
+            }
+        }
+        CHECK(covered > 200);
+        CHECK(run.out.find("\"triangles_drawn\"") != std::string::npos);
+        CHECK(run.out.find("\"boxes_culled\"") != std::string::npos);
+        CHECK(run.out.find("\"pixels_covered\": " + std::to_string(covered)) != std::string::npos);
+    }
+    TEST_CASE("compare mode prints the agreement and writes the difference image") {
+        test::TempDir dir;
+        auto run = test::runProgram(
+            program, "--headless --scene sh1 --width 64 --height 48 --out a.png --compare", dir);
+        INFO(run.err);
+        REQUIRE(run.exitCode == 0);
+        CHECK(run.out.find("same triangle:") != std::string::npos);
+        CHECK(test::pngSize(dir.file("a-diff.png")) == std::pair{64, 48});
+    }
+    TEST_CASE("measurements: the JSON report has the step's tables") {
+        test::TempDir dir;
+        auto run = test::runProgram(
+            program, "--headless --width 48 --height 36 --out a.png --measure --report r.json",
+            dir);
+        INFO(run.err);
+        REQUIRE(run.exitCode == 0);
+        std::string json = test::readText(dir.file("r.json"));
+        for (const char* id : {"\"visibility\"", "\"frame_time\"", "\"shadow_bias\"", "\"shadows\"",
+                               "\"interpolation\"", "\"culling\""})
+            CHECK(json.find(id) != std::string::npos);
+        CHECK(test::pngSize(dir.file("a-affine.png")) == std::pair{48, 36});
+    }
+    TEST_CASE("window: scripted frames with key presses under the offscreen video driver") {
+        test::TempDir dir;
+        auto run = test::runProgram(
+            program,
+            "--scene sh1 --width 64 --height 48 --frames 8 --keys r,d,h,b,p,f,Left "
+            "--screenshot shot.png",
+            dir, test::kWindowEnvironment);
+        INFO(run.err);
+        REQUIRE(run.exitCode == 0);
+        CHECK(test::pngSize(dir.file("shot.png")).first > 0);
+    }
+    TEST_CASE("bad input: one clear line and a non-zero exit") {
+        test::TempDir dir;
+        std::ofstream(dir.file("nan.obj")) << "v 0 0 0\nv 1 nan 0\nv 0 1 0\nf 1 2 3\n";
+        struct Case {
+            std::string args, expect;
+            int code;
+        };
+        for (const Case& c : std::vector<Case>{
+                 {"--scene sh1 --eye 1,2,3 --look 1,2,3", "view direction is zero", 1},
+                 {"--scene sh1 --near 0", "--near", 1},
+                 {"--scene sh1 --near -2", "--near", 1},
+                 {"--scene sh1 --near 2 --far 1", "--far", 1},
+                 {"--scene sh1 --width 0", "width", 2},
+                 {"--scene sh1 --height 0", "height", 2},
+                 {"--scene nan.obj", "non-finite", 1},
+                 {"--scene sh1 --shadows sometimes", "shadows", 2}}) {
+            INFO(c.args);
+            auto run = test::runProgram(program, "--headless --out bad.png " + c.args, dir);
+            CHECK(run.exitCode == c.code);
+            CHECK(test::lineCount(run.err) == 1);
+            CHECK(run.err.find(c.expect) != std::string::npos);
+            CHECK_FALSE(std::filesystem::exists(dir.file("bad.png")));
+        }
+    }
+    TEST_CASE("a view parallel to up renders") {
+        test::TempDir dir;
+        auto run = test::runProgram(program,
+                                    "--headless --scene sh1 --width 32 --height 24 --out a.png "
+                                    "--eye 176,100,-112 --look 176,0,-112 --up 0,1,0",
+                                    dir);
+        INFO(run.err);
+        REQUIRE(run.exitCode == 0);
+        CHECK(test::pngSize(dir.file("a.png")) == std::pair{32, 24});
+    }
+}

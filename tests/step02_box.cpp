@@ -277,10 +277,6 @@ TEST_SUITE("hard cases 02") {
 
 TEST_SUITE("program 02") {
     const std::string program = BOXES_PROGRAM;
-    // The window path leaks about 7 kB in 258 strdup/calloc allocations inside the SDL/GL
-    // stack under the offscreen driver (step 01's window leaks the same under ASan), so
-    // LeakSanitizer is off for these runs only; every other ASan check stays on.
-    const std::string kWindowEnv = "SDL_VIDEODRIVER=offscreen ASAN_OPTIONS=detect_leaks=0";
 
     TEST_CASE("the box scene renders the same image with both methods") {
         Scene a = makeBoxScene(4.0f / 3.0f), b = a;
@@ -329,7 +325,7 @@ TEST_SUITE("program 02") {
         test::TempDir dir;
         auto run = test::runProgram(
             program, "--width 64 --height 48 --frames 4 --keys m,d,m,Left --screenshot shot.png",
-            dir, kWindowEnv);
+            dir, test::kWindowEnvironment);
         INFO(run.err);
         REQUIRE(run.exitCode == 0);
         CHECK(test::pngSize(dir.file("shot.png")).first > 0);

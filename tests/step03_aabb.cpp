@@ -383,10 +383,6 @@ TEST_SUITE("why we care 03") {
 
 TEST_SUITE("program 03") {
     const std::string program = BOXES_PROGRAM;
-    // The window path leaks about 7 kB in 258 strdup/calloc allocations inside the SDL/GL
-    // stack under the offscreen driver (step 01's window leaks the same under ASan), so
-    // LeakSanitizer is off for these runs only; every other ASan check stays on.
-    const std::string kWindowEnv = "SDL_VIDEODRIVER=offscreen ASAN_OPTIONS=detect_leaks=0";
     const std::string small = " --spheres 200 --triangles 200";
 
     TEST_CASE("headless render writes a PNG of the requested size") {
@@ -419,7 +415,7 @@ TEST_SUITE("program 03") {
         auto run = test::runProgram(program,
                                     "--scene spheres --width 64 --height 48 --frames 4 --keys "
                                     "b,Left,b --screenshot shot.png",
-                                    dir, kWindowEnv);
+                                    dir, test::kWindowEnvironment);
         INFO(run.err);
         REQUIRE(run.exitCode == 0);
         CHECK(test::pngSize(dir.file("shot.png")).first > 0);

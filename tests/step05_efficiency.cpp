@@ -511,9 +511,6 @@ TEST_SUITE("renderer 05") {
 
 TEST_SUITE("program 05") {
     const std::string program = BOXES_PROGRAM;
-    // Mesa's offscreen driver keeps allocations until exit, which LeakSanitizer reports
-    // (main's tests/support.hpp has the same as test::kWindowEnvironment).
-    const std::string kWindowEnv = "SDL_VIDEODRIVER=offscreen ASAN_OPTIONS=detect_leaks=0";
 
     TEST_CASE("headless render writes the image and every preview") {
         test::TempDir dir;
@@ -546,7 +543,7 @@ TEST_SUITE("program 05") {
         auto run = test::runProgram(program,
                                     "--width 64 --height 48 --frames 8 --keys 1,2,Left,3,4,5,6,0 "
                                     "--screenshot shot.png",
-                                    dir, kWindowEnv);
+                                    dir, test::kWindowEnvironment);
         INFO(run.err);
         REQUIRE(run.exitCode == 0);
         CHECK(test::pngSize(dir.file("shot.png")).first > 0);
@@ -556,7 +553,7 @@ TEST_SUITE("program 05") {
         auto run = test::runProgram(program,
                                     "--width 48 --height 36 --photo-spp 4 --frames 40 --keys p "
                                     "--screenshot shot.png",
-                                    dir, kWindowEnv);
+                                    dir, test::kWindowEnvironment);
         INFO(run.err);
         REQUIRE(run.exitCode == 0);
         CHECK(run.out.find("photograph saved to 05_efficiency-photo-1.png") != std::string::npos);
@@ -568,7 +565,7 @@ TEST_SUITE("program 05") {
             test::runProgram(program,
                              "--width 320 --height 240 --photo-spp 64 --frames 4 --keys p,Escape,1 "
                              "--screenshot shot.png",
-                             dir, kWindowEnv);
+                             dir, test::kWindowEnvironment);
         INFO(run.err);
         REQUIRE(run.exitCode == 0);
         CHECK(run.out.find("photograph cancelled") != std::string::npos);

@@ -129,7 +129,7 @@ BvhBuildStats bvhStats(const Bvh& bvh, const BvhBuildOptions& options);
 // ---------------------------------------------------------------------------------------
 // Traversal.
 
-// A ray prepared for box tests: reciprocal direction (+-infinity for a zero component),
+// A ray prepared for box tests: reciprocal direction (+infinity for a zero component),
 // and the origin moved by a margin, so the box test is conservative with respect to the
 // watertight triangle test. That test translates the vertices to the ray origin and shears
 // them, rounding each time: it can report a hit up to a few float steps of |vertex - O|
@@ -145,12 +145,18 @@ struct TraversalRay {
         : originForMin(ray.origin + Vec3(margin)),
           originForMax(ray.origin - Vec3(margin)),
           direction(ray.direction),
-          inverseDirection(1.0f / ray.direction.x, 1.0f / ray.direction.y,
-                           1.0f / ray.direction.z),
+          inverseDirection(inverse(ray.direction.x), inverse(ray.direction.y),
+                           inverse(ray.direction.z)),
           tmin(ray.tmin),
           tmax(ray.tmax) {}
     // The margin for the triangles of `bvh` (see above).
     TraversalRay(const Ray& ray, const Bvh& bvh) : TraversalRay(ray, marginFor(ray, bvh)) {}
+
+    // 1/d, but +infinity for both +0 and -0: with -0 the slab test would meet
+    // (NaN, -infinity) for an origin on the min plane and drop a box the ray lies in;
+    // with +infinity the pair is (NaN or -inf, NaN or +inf) inside the slab (no
+    // constraint) and (+inf, +inf) or (-inf, -inf) outside it (a miss), as it must be.
+    static float inverse(float d) { return d == 0.0f ? kInfinity<float> : 1.0f / d; }
 
     static float marginFor(const Ray& ray, const Bvh& bvh) {
         if (bvh.empty()) return 0.0f;

@@ -709,7 +709,7 @@ TEST_SUITE("program 04") {
         auto bunny = test::runProgram(program,
                                       "check --mesh " + test::dataDir() +
                                           "/meshes/bunny.obj "
-                                          "--kind diffuse --count 200 --cracks 200",
+                                          "--kind diffuse --count 200 --cracks 100",
                                       dir);
         INFO(bunny.out << bunny.err);
         CHECK(bunny.exitCode == 0);

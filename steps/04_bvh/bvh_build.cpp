@@ -58,7 +58,9 @@ namespace {
 constexpr int kMaxBins = 256;
 
 // glm's operator[] is a switch; the hot loops read components through a pointer.
-inline float component(const Vec3& v, int axis) { return (&v.x)[axis]; }
+inline float component(const Vec3& v, int axis) {
+    return (&v.x)[axis];
+}
 
 struct SahBin {
     Vec3 lo, hi;  // bounds of the primitives in the bin
@@ -93,7 +95,8 @@ size_t partitionBinnedSah(std::span<BuildPrimitive> prims, const Bounds3f& nodeB
         if (!std::isfinite(scale) || !(scale > 0.0f)) continue;
         float lowest = component(centroidBounds.min, axis);
         SahBin bin[kMaxBins];
-        for (int b = 0; b < bins; ++b) bin[b] = {Vec3(kInfinity<float>), Vec3(-kInfinity<float>), 0};
+        for (int b = 0; b < bins; ++b)
+            bin[b] = {Vec3(kInfinity<float>), Vec3(-kInfinity<float>), 0};
         for (const BuildPrimitive& p : prims) {
             int b = std::min(bins - 1, int((component(p.centroid, axis) - lowest) * scale));
             bin[b].count++;
@@ -120,10 +123,10 @@ size_t partitionBinnedSah(std::span<BuildPrimitive> prims, const Bounds3f& nodeB
             lo = glm::min(lo, bin[plane - 1].lo);
             hi = glm::max(hi, bin[plane - 1].hi);
             if (count == 0 || rightCount[plane] == 0) continue;
-            float c = options.traversalCost +
-                      options.intersectionCost *
-                          (area(lo, hi) * float(count) + rightArea[plane] * float(rightCount[plane])) /
-                          nodeArea;
+            float c = options.traversalCost + options.intersectionCost *
+                                                  (area(lo, hi) * float(count) +
+                                                   rightArea[plane] * float(rightCount[plane])) /
+                                                  nodeArea;
             if (c < cost) {
                 cost = c;
                 bestAxis = axis;

@@ -339,10 +339,13 @@ int main(int argc, char** argv) {
                 for (int x = 0; x < view.width(); ++x) image.at(x, y) = view.at(x, y);
             if (geometry) {
                 const Camera& camera = orbit.camera();
-                float radius = 0.5f * glm::length(geometry->bvh().bounds().diagonal());
-                Frustum f =
-                    makeFrustum(camera, 0.01f * radius,
-                                std::max(0.02f * radius, farScale * glm::length(camera.view)));
+                Bounds3f bounds = geometry->bvh().bounds();
+                float radius = 0.5f * glm::length(bounds.diagonal());
+                // Far plane through the mesh's centre (or 3x as far): it cuts the mesh.
+                float centreDistance =
+                    glm::dot(bounds.centroid() - camera.eye, glm::normalize(camera.view));
+                Frustum f = makeFrustum(camera, 0.01f * radius,
+                                        std::max(0.02f * radius, farScale * centreDistance));
                 cullHierarchy(geometry->bvh(), f, CullTest::Planes, &planeCounts);
                 cullHierarchy(geometry->bvh(), f, CullTest::PlanesAndCorners, &cornerCounts);
                 drawCullingMap(image, settings.width, opts.width - settings.width, geometry->bvh(),

@@ -198,7 +198,7 @@ std::vector<Ray> makeRays(const Mesh& mesh, RayKind kind, size_t count, uint64_t
 }
 
 MeshBvhGeometry::MeshBvhGeometry(const Mesh& mesh, int material, const BvhBuildOptions& options)
-    : mesh_(mesh), material_(material), bvh_(buildBvh(mesh, options, &stats_)) {}
+    : mesh_(mesh), material_(material), stats_(), bvh_(buildBvh(mesh, options, &stats_)) {}
 
 bool MeshBvhGeometry::intersect(const Ray& ray, SurfaceHit& hit) const {
     TraversalRay traversal(ray, bvh_);

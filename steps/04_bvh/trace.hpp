@@ -150,8 +150,8 @@ class MeshBvhGeometry : public Geometry {
   private:
     const Mesh& mesh_;
     int material_;
+    BvhBuildStats stats_;  // before bvh_: the build fills it
     Bvh bvh_;
-    BvhBuildStats stats_;
 };
 
 }  // namespace boxes

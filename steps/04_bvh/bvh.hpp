@@ -15,6 +15,7 @@
 #pragma once
 
 #include <array>
+#include <cstddef>
 #include <cstdint>
 #include <span>
 #include <string>
@@ -129,7 +130,7 @@ BvhBuildStats bvhStats(const Bvh& bvh, const BvhBuildOptions& options);
 // ---------------------------------------------------------------------------------------
 // Traversal.
 
-// A ray prepared for box tests: reciprocal direction (+-infinity for a zero component),
+// A ray prepared for box tests: reciprocal direction (+infinity for a zero component),
 // and the origin moved by a margin, so the box test is conservative with respect to the
 // watertight triangle test. That test translates the vertices to the ray origin and shears
 // them, rounding each time: it can report a hit up to a few float steps of |vertex - O|
@@ -141,16 +142,34 @@ BvhBuildStats bvhStats(const Bvh& bvh, const BvhBuildOptions& options);
 struct TraversalRay {
     Vec3 originForMin, originForMax, direction, inverseDirection;
     float tmin, tmax;
+    // Per axis, which bound the ray meets first (offsets into a node seen as 8 floats:
+    // min at 0..2, max at 4..6) and the origin that goes with it: no swap in the slab test.
+    int nearOffset[3], farOffset[3];
+    float nearOrigin[3], farOrigin[3];
+
     explicit TraversalRay(const Ray& ray, float margin = 0.0f)
         : originForMin(ray.origin + Vec3(margin)),
           originForMax(ray.origin - Vec3(margin)),
           direction(ray.direction),
-          inverseDirection(1.0f / ray.direction.x, 1.0f / ray.direction.y,
-                           1.0f / ray.direction.z),
+          inverseDirection(inverse(ray.direction.x), inverse(ray.direction.y),
+                           inverse(ray.direction.z)),
           tmin(ray.tmin),
-          tmax(ray.tmax) {}
+          tmax(ray.tmax) {
+        for (int axis = 0; axis < 3; ++axis) {
+            bool positive = (&inverseDirection.x)[axis] >= 0.0f;
+            nearOffset[axis] = positive ? axis : 4 + axis;
+            farOffset[axis] = positive ? 4 + axis : axis;
+            nearOrigin[axis] = positive ? (&originForMin.x)[axis] : (&originForMax.x)[axis];
+            farOrigin[axis] = positive ? (&originForMax.x)[axis] : (&originForMin.x)[axis];
+        }
+    }
     // The margin for the triangles of `bvh` (see above).
     TraversalRay(const Ray& ray, const Bvh& bvh) : TraversalRay(ray, marginFor(ray, bvh)) {}
+
+    // 1/d, but +infinity for both +0 and -0: then a zero component gives (NaN or -inf,
+    // NaN or +inf) for an origin inside the slab (no constraint: the NaN is ignored below)
+    // and (+inf, +inf) or (-inf, -inf) outside it (a miss), as it must be.
+    static float inverse(float d) { return d == 0.0f ? kInfinity<float> : 1.0f / d; }
 
     static float marginFor(const Ray& ray, const Bvh& bvh) {
         if (bvh.empty()) return 0.0f;
@@ -172,16 +191,14 @@ constexpr float kBoxFarScale = 1.0f + 2.0f * (3.0f * 0x1p-24f) / (1.0f - 3.0f * 
 // contains it along that axis. Components through pointers: glm's operator[] is a switch.
 inline bool intersectNodeBounds(const BvhNode& node, const TraversalRay& ray, float tmax,
                                 float& tEntry) {
-    const float *lo = &node.boundsMin.x, *hi = &node.boundsMax.x;
-    const float *oLo = &ray.originForMin.x, *oHi = &ray.originForMax.x;
+    static_assert(offsetof(BvhNode, boundsMax) == 4 * sizeof(float), "node as 8 floats");
+    const float* bounds = &node.boundsMin.x;
     const float* inv = &ray.inverseDirection.x;
     float t0 = ray.tmin, t1 = tmax;
     for (int axis = 0; axis < 3; ++axis) {
-        float tNear = (lo[axis] - oLo[axis]) * inv[axis];
-        float tFar = (hi[axis] - oHi[axis]) * inv[axis];
-        if (tNear > tFar) std::swap(tNear, tFar);
-        tFar *= kBoxFarScale;
-        t0 = tNear > t0 ? tNear : t0;
+        float tNear = (bounds[ray.nearOffset[axis]] - ray.nearOrigin[axis]) * inv[axis];
+        float tFar = (bounds[ray.farOffset[axis]] - ray.farOrigin[axis]) * inv[axis] * kBoxFarScale;
+        t0 = tNear > t0 ? tNear : t0;  // a NaN bound is ignored (see above)
         t1 = tFar < t1 ? tFar : t1;
     }
     tEntry = t0;
@@ -204,7 +221,12 @@ uint32_t traverseNearest(const Bvh& bvh, const TraversalRay& ray, float& tCloses
     if (bvh.nodes.empty()) return kTraversalMiss;
     uint32_t nearestSlot = kTraversalMiss;
     const BvhNode* nodes = bvh.nodes.data();
-    uint32_t stack[kTraversalStackSize];
+    // The stack keeps where the ray enters each postponed node: a pop skips it without a
+    // second box test once a hit nearer than that is known.
+    struct Entry {
+        uint32_t node;
+        float tEntry;
+    } stack[kTraversalStackSize];
     int stackSize = 0;
     float tRoot;
     if (!intersectNodeBounds(nodes[0], ray, tClosest, tRoot)) return kTraversalMiss;
@@ -221,8 +243,11 @@ uint32_t traverseNearest(const Bvh& bvh, const TraversalRay& ray, float& tCloses
             bool hitNear = intersectNodeBounds(nodes[near], ray, tClosest, tNear);
             bool hitFar = intersectNodeBounds(nodes[far], ray, tClosest, tFar);
             if (hitNear && hitFar) {
-                if (tFar < tNear) std::swap(near, far);
-                stack[stackSize++] = far;
+                if (tFar < tNear) {
+                    std::swap(near, far);
+                    std::swap(tNear, tFar);
+                }
+                stack[stackSize++] = {far, tFar};
                 current = near;
                 continue;
             }
@@ -231,14 +256,12 @@ uint32_t traverseNearest(const Bvh& bvh, const TraversalRay& ray, float& tCloses
                 continue;
             }
         }
-        // Pop until a node the ray can still reach before tClosest (entry test again: the
-        // hit may have come closer since it was pushed).
+        // Pop until a node the ray enters before the nearest hit so far (early out).
         bool found = false;
         while (stackSize > 0) {
-            uint32_t candidate = stack[--stackSize];
-            float tEntry;
-            if (intersectNodeBounds(nodes[candidate], ray, tClosest, tEntry)) {
-                current = candidate;
+            const Entry& e = stack[--stackSize];
+            if (e.tEntry <= tClosest) {
+                current = e.node;
                 found = true;
                 break;
             }

@@ -57,10 +57,20 @@ namespace {
 
 constexpr int kMaxBins = 256;
 
+// glm's operator[] is a switch; the hot loops read components through a pointer.
+inline float component(const Vec3& v, int axis) {
+    return (&v.x)[axis];
+}
+
 struct SahBin {
-    Bounds3f bounds;
-    uint32_t count = 0;
+    Vec3 lo, hi;  // bounds of the primitives in the bin
+    uint32_t count;
 };
+
+inline float area(const Vec3& lo, const Vec3& hi) {
+    Vec3 d = hi - lo;
+    return 2.0f * (d.x * d.y + d.y * d.z + d.z * d.x);
+}
 
 }  // namespace
 
@@ -79,41 +89,42 @@ size_t partitionBinnedSah(std::span<BuildPrimitive> prims, const Bounds3f& nodeB
     Vec3 extent = centroidBounds.diagonal();
     for (int axis = 0; axis < 3; ++axis) {
         // A zero extent has nothing to split (and would divide by zero below).
-        if (!(extent[axis] > 0.0f)) continue;
-        float scale = float(bins) / extent[axis];
+        float axisExtent = component(extent, axis);
+        if (!(axisExtent > 0.0f)) continue;
+        float scale = float(bins) / axisExtent;
         if (!std::isfinite(scale) || !(scale > 0.0f)) continue;
+        float lowest = component(centroidBounds.min, axis);
         SahBin bin[kMaxBins];
+        for (int b = 0; b < bins; ++b)
+            bin[b] = {Vec3(kInfinity<float>), Vec3(-kInfinity<float>), 0};
         for (const BuildPrimitive& p : prims) {
-            int b = std::min(bins - 1, int((p.centroid[axis] - centroidBounds.min[axis]) * scale));
+            int b = std::min(bins - 1, int((component(p.centroid, axis) - lowest) * scale));
             bin[b].count++;
-            bin[b].bounds.extend(p.bounds.min);
-            bin[b].bounds.extend(p.bounds.max);
+            bin[b].lo = glm::min(bin[b].lo, p.bounds.min);
+            bin[b].hi = glm::max(bin[b].hi, p.bounds.max);
         }
         // Sweep from the right: area and count right of each plane; then from the left.
         float rightArea[kMaxBins];
         uint32_t rightCount[kMaxBins];
-        Bounds3f right;
+        Vec3 lo(kInfinity<float>), hi(-kInfinity<float>);
         uint32_t count = 0;
         for (int plane = bins - 1; plane > 0; --plane) {
             count += bin[plane].count;
-            if (bin[plane].count) {
-                right.extend(bin[plane].bounds.min);
-                right.extend(bin[plane].bounds.max);
-            }
-            rightArea[plane] = right.surfaceArea();
+            lo = glm::min(lo, bin[plane].lo);
+            hi = glm::max(hi, bin[plane].hi);
+            rightArea[plane] = count ? area(lo, hi) : 0.0f;
             rightCount[plane] = count;
         }
-        Bounds3f left;
+        lo = Vec3(kInfinity<float>);
+        hi = Vec3(-kInfinity<float>);
         count = 0;
         for (int plane = 1; plane < bins; ++plane) {
             count += bin[plane - 1].count;
-            if (bin[plane - 1].count) {
-                left.extend(bin[plane - 1].bounds.min);
-                left.extend(bin[plane - 1].bounds.max);
-            }
+            lo = glm::min(lo, bin[plane - 1].lo);
+            hi = glm::max(hi, bin[plane - 1].hi);
             if (count == 0 || rightCount[plane] == 0) continue;
             float c = options.traversalCost + options.intersectionCost *
-                                                  (left.surfaceArea() * float(count) +
+                                                  (area(lo, hi) * float(count) +
                                                    rightArea[plane] * float(rightCount[plane])) /
                                                   nodeArea;
             if (c < cost) {
@@ -126,9 +137,9 @@ size_t partitionBinnedSah(std::span<BuildPrimitive> prims, const Bounds3f& nodeB
     }
     if (bestAxis < 0) return 0;
     // Partition with the same bin arithmetic, so every primitive lands where it was counted.
+    float lowest = component(centroidBounds.min, bestAxis);
     auto middle = std::partition(prims.begin(), prims.end(), [&](const BuildPrimitive& p) {
-        int b = std::min(bins - 1,
-                         int((p.centroid[bestAxis] - centroidBounds.min[bestAxis]) * bestScale));
+        int b = std::min(bins - 1, int((component(p.centroid, bestAxis) - lowest) * bestScale));
         return b < bestPlane;
     });
     return size_t(middle - prims.begin());

@@ -115,7 +115,8 @@ int runCheck(const CheckOptions& o) {
 }
 
 std::string withSuffix(const std::string& png, const std::string& suffix) {
-    std::string stem = png.size() > 4 && png.ends_with(".png") ? png.substr(0, png.size() - 4) : png;
+    std::string stem =
+        png.size() > 4 && png.ends_with(".png") ? png.substr(0, png.size() - 4) : png;
     return stem + suffix + ".png";
 }
 
@@ -127,12 +128,14 @@ const char* testName(CullTest test) {
 
 int main(int argc, char** argv) {
     return runMain("04_bvh", [&] {
-        CLI::App app{"Step 04: bounding volume hierarchies: builders, traversal, frustum culling, "
-                     "and a trace command for ray files."};
+        CLI::App app{
+            "Step 04: bounding volume hierarchies: builders, traversal, frustum culling, "
+            "and a trace command for ray files."};
         CommonOptions opts;
         addCommonOptions(app, opts, "bunny");
         std::string builderName = "sah";
-        app.add_option("--builder", builderName, "hierarchy builder: midpoint, median, sah, sweep-sah")
+        app.add_option("--builder", builderName,
+                       "hierarchy builder: midpoint, median, sah, sweep-sah")
             ->capture_default_str();
         int bins = 16;
         app.add_option("--bins", bins, "binned SAH: bins per axis")
@@ -143,14 +146,19 @@ int main(int argc, char** argv) {
         size_t measureRays = 100000;
         app.add_option("--measure-rays", measureRays, "rays per kind in the speed table")
             ->check(CLI::Range(size_t(100), size_t(10000000)));
+        size_t crackRays = 5000;
+        app.add_option("--crack-rays", crackRays, "rays per mesh and feature for the crack count")
+            ->check(CLI::Range(size_t(1), size_t(10000000)));
 
         TraceOptions trace;
         CLI::App* traceCommand = app.add_subcommand(
             "trace", "trace RAYS.bin against MESH.obj, write HITS.bin, print one JSON line");
         traceCommand->add_option("--mesh", trace.mesh, "the mesh (OBJ)")->required();
-        traceCommand->add_option("--rays", trace.rays, "float32 ox oy oz tmin dx dy dz tmax per ray")
+        traceCommand
+            ->add_option("--rays", trace.rays, "float32 ox oy oz tmin dx dy dz tmax per ray")
             ->required();
-        traceCommand->add_option("--hits", trace.hits, "written: float32 t, uint32 triangle per ray")
+        traceCommand
+            ->add_option("--hits", trace.hits, "written: float32 t, uint32 triangle per ray")
             ->required();
         traceCommand->add_option("--builder", trace.builder, "midpoint, median, sah or sweep-sah")
             ->check(CLI::IsMember({"midpoint", "median", "sah", "sweep-sah"}))
@@ -167,7 +175,8 @@ int main(int argc, char** argv) {
 
         CheckOptions check;
         CLI::App* checkCommand = app.add_subcommand(
-            "check", "compare every builder's nearest hits with brute force; exit 1 on a difference");
+            "check",
+            "compare every builder's nearest hits with brute force; exit 1 on a difference");
         checkCommand->add_option("--mesh", check.mesh, "the mesh (OBJ)")->required();
         checkCommand->add_option("--rays", check.rays, "a rays file (else --kind and --count)");
         checkCommand->add_option("--kind", check.kind, "generated rays: primary, diffuse, random")
@@ -190,7 +199,8 @@ int main(int argc, char** argv) {
         Scene scene = sceneFromOptions(opts);
         std::shared_ptr<MeshBvhGeometry> geometry;
         if (scene.hasMesh()) {
-            geometry = std::make_shared<MeshBvhGeometry>(scene.mesh, scene.meshMaterial, buildOptions);
+            geometry =
+                std::make_shared<MeshBvhGeometry>(scene.mesh, scene.meshMaterial, buildOptions);
             scene.geometries.push_back(geometry);
         }
         Vec3 sceneUp = scene.camera.up;
@@ -225,12 +235,14 @@ int main(int argc, char** argv) {
                 CullingView v = cullingView(geometry->bvh().bounds(), 1, 8, opts.aspect());
                 Frustum f = makeFrustum(v.camera, v.nearDistance, v.farDistance);
                 Image map(opts.width, opts.height);
-                drawCullingMap(map, 0, opts.width, geometry->bvh(), f, CullTest::Planes, 6, sceneUp);
+                drawCullingMap(map, 0, opts.width, geometry->bvh(), f, CullTest::Planes, 6,
+                               sceneUp);
                 std::string mapPath = withSuffix(out, "-cull");
                 map.writePng(mapPath);
                 report.images.push_back(
-                    {mapPath, "the hierarchy from above (depth 6): grey culled, green kept, red "
-                              "wrongly kept by the plane test; the frustum in blue"});
+                    {mapPath,
+                     "the hierarchy from above (depth 6): grey culled, green kept, red "
+                     "wrongly kept by the plane test; the frustum in blue"});
             }
             if (measure && geometry) {
                 NamedMesh named{scene.name, &scene.mesh};
@@ -243,7 +255,8 @@ int main(int argc, char** argv) {
                 Mesh sh1 = loadObj(opts.dataDir + "/meshes/sh1.obj");
                 Mesh bunny = scene.name == "bunny" ? scene.mesh
                                                    : loadObj(opts.dataDir + "/meshes/bunny.obj");
-                report.add(measureBvhCracks({{"bunny", &bunny}, {"sh1", &sh1}}, 5000, opts.seed));
+                report.add(
+                    measureBvhCracks({{"bunny", &bunny}, {"sh1", &sh1}}, crackRays, opts.seed));
                 std::cerr << "04_bvh: culling...\n";
                 report.add(measureCulling(named, geometry->bvh(), 8));
                 // Build time against trace speed, one point per builder (primary rays).
@@ -293,8 +306,8 @@ int main(int argc, char** argv) {
             if (key == SDLK_b && geometry) {
                 buildOptions.builder = BvhBuilder((int(buildOptions.builder) + 1) % 3);
                 scene.geometries.clear();
-                geometry = std::make_shared<MeshBvhGeometry>(scene.mesh, scene.meshMaterial,
-                                                             buildOptions);
+                geometry =
+                    std::make_shared<MeshBvhGeometry>(scene.mesh, scene.meshMaterial, buildOptions);
                 scene.geometries.push_back(geometry);
                 return dirty = true;
             }
@@ -326,9 +339,13 @@ int main(int argc, char** argv) {
                 for (int x = 0; x < view.width(); ++x) image.at(x, y) = view.at(x, y);
             if (geometry) {
                 const Camera& camera = orbit.camera();
-                float radius = 0.5f * glm::length(geometry->bvh().bounds().diagonal());
+                Bounds3f bounds = geometry->bvh().bounds();
+                float radius = 0.5f * glm::length(bounds.diagonal());
+                // Far plane through the mesh's centre (or 3x as far): it cuts the mesh.
+                float centreDistance =
+                    glm::dot(bounds.centroid() - camera.eye, glm::normalize(camera.view));
                 Frustum f = makeFrustum(camera, 0.01f * radius,
-                                        std::max(0.02f * radius, farScale * glm::length(camera.view)));
+                                        std::max(0.02f * radius, farScale * centreDistance));
                 cullHierarchy(geometry->bvh(), f, CullTest::Planes, &planeCounts);
                 cullHierarchy(geometry->bvh(), f, CullTest::PlanesAndCorners, &cornerCounts);
                 drawCullingMap(image, settings.width, opts.width - settings.width, geometry->bvh(),
@@ -338,7 +355,8 @@ int main(int argc, char** argv) {
             return image;
         };
         cb.panel = [&] {
-            ImGui::Text("builder: %s  render: %.1f ms", bvhBuilderName(buildOptions.builder), renderMs);
+            ImGui::Text("builder: %s  render: %.1f ms", bvhBuilderName(buildOptions.builder),
+                        renderMs);
             if (!geometry) return;
             const BvhBuildStats& s = geometry->stats();
             ImGui::Text("build %.1f ms, %zu nodes, depth %d, SAH cost %.1f", s.buildMs, s.nodes,

@@ -19,7 +19,8 @@ TraceHit traceBruteForce(const Mesh& mesh, const Ray& ray) {
         LeafTriangle tri{mesh.vertex(i, 0), mesh.vertex(i, 1), mesh.vertex(i, 2)};
         float t = tClosest;
         // Strictly nearer only: the first of equally near triangles stays.
-        if (intersectLeafTriangle(watertight, tri, t) && (best.triangle == kNoPrimitive || t < tClosest)) {
+        if (intersectLeafTriangle(watertight, tri, t) &&
+            (best.triangle == kNoPrimitive || t < tClosest)) {
             tClosest = t;
             best = {t, uint32_t(i)};
         }
@@ -45,7 +46,8 @@ std::vector<Ray> readRays(const std::string& path) {
     rays.reserve(records.size());
     for (size_t i = 0; i < records.size(); ++i) {
         const RayRecord& r = records[i];
-        Vec3 o(r.origin[0], r.origin[1], r.origin[2]), d(r.direction[0], r.direction[1], r.direction[2]);
+        Vec3 o(r.origin[0], r.origin[1], r.origin[2]),
+            d(r.direction[0], r.direction[1], r.direction[2]);
         std::string where = "rays file '" + path + "': ray " + std::to_string(i) + ": ";
         if (std::isnan(o.x) || std::isnan(o.y) || std::isnan(o.z) || std::isnan(d.x) ||
             std::isnan(d.y) || std::isnan(d.z) || std::isnan(r.tmin) || std::isnan(r.tmax))
@@ -61,8 +63,10 @@ void writeRays(const std::string& path, const std::vector<Ray>& rays) {
     std::vector<RayRecord> records(rays.size());
     for (size_t i = 0; i < rays.size(); ++i) {
         const Ray& r = rays[i];
-        records[i] = {{r.origin.x, r.origin.y, r.origin.z}, r.tmin,
-                      {r.direction.x, r.direction.y, r.direction.z}, r.tmax};
+        records[i] = {{r.origin.x, r.origin.y, r.origin.z},
+                      r.tmin,
+                      {r.direction.x, r.direction.y, r.direction.z},
+                      r.tmax};
     }
     writeFileAtomically(path, records.data(), records.size() * sizeof(RayRecord));
 }
@@ -122,9 +126,12 @@ void traceBatchBruteForce(const Mesh& mesh, const std::vector<Ray>& rays,
 
 const char* rayKindName(RayKind kind) {
     switch (kind) {
-        case RayKind::Primary: return "primary";
-        case RayKind::Diffuse: return "diffuse";
-        default: return "random";
+        case RayKind::Primary:
+            return "primary";
+        case RayKind::Diffuse:
+            return "diffuse";
+        default:
+            return "random";
     }
 }
 
@@ -162,7 +169,7 @@ std::vector<Ray> makeRays(const Mesh& mesh, RayKind kind, size_t count, uint64_t
         double sum = 0.0;
         for (size_t i = 0; i < mesh.triangles.size(); ++i) {
             sum += 0.5 * glm::length(Vec3d(glm::cross(mesh.vertex(i, 1) - mesh.vertex(i, 0),
-                                                       mesh.vertex(i, 2) - mesh.vertex(i, 0))));
+                                                      mesh.vertex(i, 2) - mesh.vertex(i, 0))));
             cumulative[i] = sum;
         }
         std::uniform_real_distribution<double> pick(0.0, sum);
@@ -191,7 +198,7 @@ std::vector<Ray> makeRays(const Mesh& mesh, RayKind kind, size_t count, uint64_t
 }
 
 MeshBvhGeometry::MeshBvhGeometry(const Mesh& mesh, int material, const BvhBuildOptions& options)
-    : mesh_(mesh), material_(material), bvh_(buildBvh(mesh, options, &stats_)) {}
+    : mesh_(mesh), material_(material), stats_(), bvh_(buildBvh(mesh, options, &stats_)) {}
 
 bool MeshBvhGeometry::intersect(const Ray& ray, SurfaceHit& hit) const {
     TraversalRay traversal(ray, bvh_);
@@ -226,6 +233,8 @@ bool MeshBvhGeometry::intersect(const Ray& ray, SurfaceHit& hit) const {
     return true;
 }
 
-bool MeshBvhGeometry::occluded(const Ray& ray) const { return traceOccluded(bvh_, ray); }
+bool MeshBvhGeometry::occluded(const Ray& ray) const {
+    return traceOccluded(bvh_, ray);
+}
 
 }  // namespace boxes

@@ -137,7 +137,7 @@ std::vector<Ray> makeRays(const Mesh& mesh, RayKind kind, size_t count, uint64_t
 
 // The mesh as renderer geometry, through the hierarchy.
 class MeshBvhGeometry : public Geometry {
-public:
+  public:
     MeshBvhGeometry(const Mesh& mesh, int material, const BvhBuildOptions& options);
     bool intersect(const Ray& ray, SurfaceHit& hit) const override;
     bool occluded(const Ray& ray) const override;
@@ -147,11 +147,11 @@ public:
     const Bvh& bvh() const { return bvh_; }
     const BvhBuildStats& stats() const { return stats_; }
 
-private:
+  private:
     const Mesh& mesh_;
     int material_;
+    BvhBuildStats stats_;  // before bvh_: the build fills it
     Bvh bvh_;
-    BvhBuildStats stats_;
 };
 
 }  // namespace boxes

@@ -1,0 +1,763 @@
+// Step 04: hierarchy builders (by the structure they build), traversal (on trees from the
+// non-exercise sweep-SAH builder, with a test-local triangle test), frustum culling with
+// hand-worked numbers, the trace command and its file formats.
+#include <doctest/doctest.h>
+
+#include <algorithm>
+#include <random>
+#include <set>
+
+#include "04_bvh/frustum.hpp"
+#include "04_bvh/trace.hpp"
+#include "core/mesh.hpp"
+#include "support.hpp"
+
+using namespace boxes;
+
+namespace {
+
+Bounds3f unitBoxAt(Vec3 lo) {
+    return {lo, lo + Vec3(1.0f)};
+}
+
+std::vector<BuildPrimitive> primitivesOf(const std::vector<Bounds3f>& boxes) {
+    std::vector<BuildPrimitive> prims;
+    for (size_t i = 0; i < boxes.size(); ++i)
+        prims.push_back({boxes[i], boxes[i].centroid(), uint32_t(i)});
+    return prims;
+}
+
+Bounds3f centroidBounds(const std::vector<BuildPrimitive>& prims) {
+    Bounds3f b;
+    for (const auto& p : prims) b.extend(p.centroid);
+    return b;
+}
+
+Bounds3f boundsOf(const std::vector<BuildPrimitive>& prims) {
+    Bounds3f b;
+    for (const auto& p : prims) {
+        b.extend(p.bounds.min);
+        b.extend(p.bounds.max);
+    }
+    return b;
+}
+
+// Random small triangles in the unit cube (a soup: the hard, overlapping case).
+Mesh triangleSoup(size_t count, uint64_t seed, float size = 0.08f) {
+    std::mt19937_64 rng(seed);
+    std::uniform_real_distribution<float> u(0.0f, 1.0f);
+    Mesh m;
+    for (size_t i = 0; i < count; ++i) {
+        Vec3 c(u(rng), u(rng), u(rng));
+        for (int k = 0; k < 3; ++k)
+            m.positions.push_back(c + size * (Vec3(u(rng), u(rng), u(rng)) - 0.5f));
+        m.triangles.push_back({uint32_t(3 * i), uint32_t(3 * i + 1), uint32_t(3 * i + 2)});
+    }
+    return m;
+}
+
+// Checks what every builder must give: each primitive in exactly one leaf, node bounds
+// equal to the union of their children (leaves: of their primitives), children adjacent
+// after the parent, depth within the cap.
+void checkStructure(const Bvh& bvh, const std::vector<Bounds3f>& boxes, int maxDepth = 64) {
+    REQUIRE_FALSE(bvh.empty());
+    REQUIRE(bvh.primitiveIndices.size() == boxes.size());
+    std::vector<int> seen(boxes.size(), 0);
+    std::vector<std::pair<uint32_t, int>> stack = {{0, 0}};
+    size_t reached = 0;
+    while (!stack.empty()) {
+        auto [index, depth] = stack.back();
+        stack.pop_back();
+        ++reached;
+        REQUIRE(index < bvh.nodes.size());
+        const BvhNode& node = bvh.nodes[index];
+        CHECK(depth < maxDepth);
+        Bounds3f expected;
+        if (node.isLeaf()) {
+            REQUIRE(size_t(node.leftFirst) + node.count <= boxes.size());
+            for (uint32_t s = node.leftFirst; s < node.leftFirst + node.count; ++s) {
+                uint32_t p = bvh.primitiveIndices[s];
+                REQUIRE(p < boxes.size());
+                ++seen[p];
+                expected.extend(boxes[p].min);
+                expected.extend(boxes[p].max);
+            }
+        } else {
+            REQUIRE(node.leftFirst > index);
+            REQUIRE(node.leftFirst + 1 < bvh.nodes.size());
+            for (uint32_t c : {node.leftFirst, node.leftFirst + 1}) {
+                expected.extend(bvh.nodes[c].boundsMin);
+                expected.extend(bvh.nodes[c].boundsMax);
+                stack.push_back({c, depth + 1});
+            }
+        }
+        CHECK(node.bounds() == expected);
+    }
+    CHECK(reached == bvh.nodes.size());
+    for (int n : seen) REQUIRE(n == 1);
+}
+
+std::vector<Bounds3f> triangleBounds(const Mesh& m) {
+    std::vector<Bounds3f> boxes;
+    for (size_t i = 0; i < m.triangleCount(); ++i) {
+        Bounds3f b;
+        for (int k = 0; k < 3; ++k) b.extend(m.vertex(i, k));
+        boxes.push_back(b);
+    }
+    return boxes;
+}
+
+BvhBuildOptions optionsFor(BvhBuilder builder) {
+    BvhBuildOptions o;
+    o.builder = builder;
+    return o;
+}
+
+// Test-local reference triangle test: Moller-Trumbore in double (not step 01's exercise).
+bool referenceTriangle(const Ray& ray, const LeafTriangle& tri, double& t) {
+    Vec3d o(ray.origin), d(ray.direction), a(tri.a), b(tri.b), c(tri.c);
+    Vec3d e1 = b - a, e2 = c - a, p = glm::cross(d, e2);
+    double det = glm::dot(e1, p);
+    if (det == 0.0) return false;
+    Vec3d s = o - a;
+    double u = glm::dot(s, p) / det;
+    Vec3d q = glm::cross(s, e1);
+    double v = glm::dot(d, q) / det;
+    if (u < 0.0 || v < 0.0 || u + v > 1.0) return false;
+    t = glm::dot(e2, q) / det;
+    return t >= ray.tmin && t <= ray.tmax;
+}
+
+// Nearest through the hierarchy with the reference test; the slot's primitive or miss.
+uint32_t nearestWithReference(const Bvh& bvh, const Ray& ray, double& tBest) {
+    tBest = kInfinity<double>;
+    float tClosest = ray.tmax;
+    uint32_t slot = traverseNearest(bvh, TraversalRay(ray), tClosest, [&](uint32_t s, float& tmax) {
+        double t;
+        if (!referenceTriangle(ray, bvh.leafTriangles[s], t) || !(t <= double(tmax)) ||
+            !(t < tBest))
+            return false;
+        tBest = t;
+        tmax = float(t);
+        return true;
+    });
+    return slot == kTraversalMiss ? kNoPrimitive : bvh.primitiveIndices[slot];
+}
+
+uint32_t bruteWithReference(const Mesh& m, const Ray& ray, double& tBest) {
+    tBest = kInfinity<double>;
+    uint32_t best = kNoPrimitive;
+    for (size_t i = 0; i < m.triangleCount(); ++i) {
+        double t;
+        LeafTriangle tri{m.vertex(i, 0), m.vertex(i, 1), m.vertex(i, 2)};
+        if (referenceTriangle(ray, tri, t) && t < tBest) {
+            tBest = t;
+            best = uint32_t(i);
+        }
+    }
+    return best;
+}
+
+std::vector<Ray> randomRays(size_t count, uint64_t seed) {
+    std::mt19937_64 rng(seed);
+    std::uniform_real_distribution<float> u(-0.2f, 1.2f), d(-1.0f, 1.0f);
+    std::vector<Ray> rays;
+    while (rays.size() < count) {
+        Vec3 dir(d(rng), d(rng), d(rng));
+        if (glm::length(dir) < 0.1f) continue;
+        rays.emplace_back(Vec3(u(rng), u(rng), u(rng)), dir);
+    }
+    return rays;
+}
+
+// A camera at the origin looking down -z, 90 degree field of view, square.
+Camera frustumCamera() {
+    Camera c;
+    c.eye = Vec3(0.0f);
+    c.view = Vec3(0, 0, -1);
+    c.up = Vec3(0, 1, 0);
+    c.fovYDegrees = 90.0f;
+    c.aspect = 1.0f;
+    return c;
+}
+
+// Hand-made frustum of that camera (near 1, far 100), so the culling tests do not depend
+// on exercise 4.6.
+Frustum handFrustum() {
+    Frustum f;
+    float s = std::sqrt(0.5f);
+    f.planes[kLeftPlane] = {Vec3(s, 0, -s), 0.0f};    // x >= z
+    f.planes[kRightPlane] = {Vec3(-s, 0, -s), 0.0f};  // x <= -z
+    f.planes[kBottomPlane] = {Vec3(0, s, -s), 0.0f};  // y >= z
+    f.planes[kTopPlane] = {Vec3(0, -s, -s), 0.0f};    // y <= -z
+    f.planes[kNearPlane] = {Vec3(0, 0, -1), -1.0f};   // z <= -1
+    f.planes[kFarPlane] = {Vec3(0, 0, 1), 100.0f};    // z >= -100
+    f.corners = {Vec3(-1, 1, -1),        Vec3(1, 1, -1),        Vec3(-1, -1, -1),
+                 Vec3(1, -1, -1),        Vec3(-100, 100, -100), Vec3(100, 100, -100),
+                 Vec3(-100, -100, -100), Vec3(100, -100, -100)};
+    return f;
+}
+
+}  // namespace
+
+TEST_SUITE("exercise 4.1") {
+    TEST_CASE("midpoint: hand-worked split of four boxes") {
+        // Centroids at x = 0.5, 1.5, 2.5, 10.5: centroid bounds [0.5, 10.5], middle 5.5.
+        auto prims = primitivesOf({unitBoxAt({10, 0, 0}), unitBoxAt({0, 0, 0}),
+                                   unitBoxAt({2, 0, 0}), unitBoxAt({1, 0, 0})});
+        size_t left = partitionMidpoint(prims, centroidBounds(prims));
+        CHECK(left == 3);
+        for (size_t i = 0; i < prims.size(); ++i) CHECK((prims[i].centroid.x < 5.5f) == (i < 3));
+    }
+    TEST_CASE("midpoint: the longest axis of the centroid bounds is split") {
+        auto prims = primitivesOf({unitBoxAt({0, 0, 0}), unitBoxAt({0, 8, 0}), unitBoxAt({1, 1, 0}),
+                                   unitBoxAt({0, 5, 1})});
+        size_t left = partitionMidpoint(prims, centroidBounds(prims));  // y, middle 4.5
+        CHECK(left == 2);
+        for (size_t i = 0; i < 2; ++i) CHECK(prims[i].centroid.y < 4.5f);
+    }
+    TEST_CASE("midpoint: every triangle in one leaf and bounds that fit") {
+        Mesh m = triangleSoup(3000, 7);
+        Bvh bvh = buildBvh(m, optionsFor(BvhBuilder::Midpoint));
+        checkStructure(bvh, triangleBounds(m));
+        BvhBuildStats s = bvhStats(bvh, optionsFor(BvhBuilder::Midpoint));
+        CHECK(s.maxLeafSize <= 4);
+        CHECK(s.leaves * 2 - 1 == s.nodes);
+    }
+}
+
+TEST_SUITE("exercise 4.2") {
+    TEST_CASE("median: half on each side and ordered along the axis") {
+        auto prims =
+            primitivesOf({unitBoxAt({9, 0, 0}), unitBoxAt({0, 0, 0}), unitBoxAt({100, 0, 0}),
+                          unitBoxAt({3, 0, 0}), unitBoxAt({1, 0, 0})});
+        size_t left = partitionMedian(prims, centroidBounds(prims));
+        CHECK(left == 2);
+        float maxLeft = std::max(prims[0].centroid.x, prims[1].centroid.x);
+        for (size_t i = 2; i < prims.size(); ++i) CHECK(prims[i].centroid.x >= maxLeft);
+        CHECK(maxLeft == 1.5f);
+    }
+    TEST_CASE("median: a balanced tree") {
+        Mesh m = triangleSoup(4096, 8);
+        Bvh bvh = buildBvh(m, optionsFor(BvhBuilder::Median));
+        checkStructure(bvh, triangleBounds(m));
+        BvhBuildStats s = bvhStats(bvh, optionsFor(BvhBuilder::Median));
+        // 4096 / 2^10 = 4 per leaf: exactly 10 levels below the root, 1024 leaves.
+        CHECK(s.depth == 10);
+        CHECK(s.leaves == 1024);
+        CHECK(s.minLeafSize == 4);
+        CHECK(s.maxLeafSize == 4);
+    }
+}
+
+TEST_SUITE("exercise 4.3") {
+    TEST_CASE("binned SAH: two clusters are split between them with the hand-worked cost") {
+        // Node [0,10]x[0,1]x[0,1]: area 2(10 + 1 + 10) = 42; each unit box has area 6.
+        auto prims = primitivesOf({unitBoxAt({9, 0, 0}), unitBoxAt({0, 0, 0})});
+        BvhBuildOptions o = optionsFor(BvhBuilder::BinnedSah);
+        float cost = 0.0f;
+        size_t left = partitionBinnedSah(prims, boundsOf(prims), centroidBounds(prims), o, cost);
+        CHECK(left == 1);
+        CHECK(prims[0].centroid.x == 0.5f);
+        CHECK(cost == doctest::Approx(1.0 + 12.0 / 42.0).epsilon(1e-6));
+    }
+    TEST_CASE("binned SAH: the cheaper of two planes wins") {
+        // x: 0 | 4 5 | 10 ... boxes at 0, 4, 5 and 10: the split 0,4,5 | 10 separates the
+        // far box; cost 1 + (A([0,6]) * 3 + A(unit) * 1) / A([0,11]) = 1 + (26*3 + 6)/46.
+        auto prims = primitivesOf({unitBoxAt({0, 0, 0}), unitBoxAt({4, 0, 0}), unitBoxAt({5, 0, 0}),
+                                   unitBoxAt({10, 0, 0})});
+        BvhBuildOptions o = optionsFor(BvhBuilder::BinnedSah);
+        o.bins = 20;
+        float cost = 0.0f;
+        size_t left = partitionBinnedSah(prims, boundsOf(prims), centroidBounds(prims), o, cost);
+        // Candidates: {0}|{4,5,10}: 1 + (6 + 3*A([4,11]=30))/46 = 1 + 96/46;
+        //             {0,4}|{5,10}: 1 + (2*A([0,5]=22) + 2*A([5,11]=26))/46 = 1 + 96/46;
+        //             {0,4,5}|{10}: 1 + (3*A([0,6]=26) + 6)/46 = 1 + 84/46 (best).
+        CHECK(left == 3);
+        CHECK(cost == doctest::Approx(1.0 + 84.0 / 46.0).epsilon(1e-6));
+    }
+    TEST_CASE("binned SAH: identical centroids give no split and no division by zero") {
+        auto prims =
+            primitivesOf({unitBoxAt({1, 2, 3}), unitBoxAt({1, 2, 3}), unitBoxAt({1, 2, 3})});
+        float cost = 0.0f;
+        size_t left = partitionBinnedSah(prims, boundsOf(prims), centroidBounds(prims),
+                                         optionsFor(BvhBuilder::BinnedSah), cost);
+        CHECK(left == 0);
+        CHECK(cost == kInfinity<float>);
+    }
+    TEST_CASE("binned SAH: structure and a cost close to the full sweep") {
+        Mesh m = triangleSoup(4000, 9);
+        for (int bins : {4, 16, 64}) {
+            INFO("bins " << bins);
+            BvhBuildOptions o = optionsFor(BvhBuilder::BinnedSah);
+            o.bins = bins;
+            BvhBuildStats s, sweep;
+            Bvh bvh = buildBvh(m, o, &s);
+            checkStructure(bvh, triangleBounds(m));
+            buildBvh(m, optionsFor(BvhBuilder::SweepSah), &sweep);
+            CHECK(s.sahCost <= sweep.sahCost * (bins >= 16 ? 1.05 : 1.15));
+            CHECK(s.maxLeafSize <= size_t(o.maxLeafSize));
+        }
+    }
+}
+
+TEST_SUITE("hard cases 04") {
+    TEST_CASE("hard case: identical centroids build a finite tree for every builder") {
+        std::vector<Bounds3f> boxes(1000, Bounds3f(Vec3(-1.0f), Vec3(1.0f)));
+        for (BvhBuilder b : kExerciseBuilders) {
+            INFO(bvhBuilderName(b));
+            BvhBuildStats s;
+            Bvh bvh = buildBvh(boxes, optionsFor(b), &s);
+            checkStructure(bvh, boxes);
+            CHECK(s.depth <= 10);  // halves in array order: log2(1000 / 4) levels and a bit
+        }
+    }
+    TEST_CASE("hard case: flat boxes and a depth cap") {
+        // Triangles in the plane z = 0 (flat boxes), and points on a line (no area at all).
+        std::vector<Bounds3f> flat, line;
+        for (int i = 0; i < 500; ++i) {
+            flat.push_back({Vec3(float(i % 25), float(i / 25), 0.0f),
+                            Vec3(float(i % 25) + 1.0f, float(i / 25) + 1.0f, 0.0f)});
+            line.push_back({Vec3(float(i), 0.0f, 0.0f), Vec3(float(i), 0.0f, 0.0f)});
+        }
+        for (BvhBuilder b : kExerciseBuilders) {
+            INFO(bvhBuilderName(b));
+            checkStructure(buildBvh(flat, optionsFor(b)), flat);
+            checkStructure(buildBvh(line, optionsFor(b)), line);
+            BvhBuildOptions capped = optionsFor(b);
+            capped.maxDepth = 3;
+            BvhBuildStats s;
+            checkStructure(buildBvh(flat, capped, &s), flat, 3);
+            CHECK(s.depth <= 2);
+        }
+    }
+    TEST_CASE("hard case: an empty list and a single primitive") {
+        for (BvhBuilder b : kExerciseBuilders) {
+            CHECK(buildBvh(std::vector<Bounds3f>{}, optionsFor(b)).empty());
+            std::vector<Bounds3f> one = {unitBoxAt({0, 0, 0})};
+            Bvh bvh = buildBvh(one, optionsFor(b));
+            REQUIRE(bvh.nodes.size() == 1);
+            CHECK(bvh.nodes[0].count == 1);
+        }
+    }
+    TEST_CASE("hard case: huge coordinates and a large scene") {
+        Mesh m = triangleSoup(50000, 10, 0.01f);
+        for (Vec3& p : m.positions) p = p * 1e20f + Vec3(3e20f, -1e20f, 0.0f);
+        for (BvhBuilder b : kExerciseBuilders) {
+            INFO(bvhBuilderName(b));
+            Bvh bvh = buildBvh(m, optionsFor(b));
+            checkStructure(bvh, triangleBounds(m));
+            // A ray at the centroid of triangle 123 finds a triangle at least that near.
+            Vec3 target = (m.vertex(123, 0) + m.vertex(123, 1) + m.vertex(123, 2)) / 3.0f;
+            Vec3 origin = target + Vec3(0.0f, 0.0f, 5e20f);
+            Ray ray(origin, target - origin);
+            TraceHit h = traceNearest(bvh, ray);
+            CHECK(h.triangle != kNoPrimitive);
+            CHECK(h.t <= 1.0001f);
+        }
+    }
+}
+
+TEST_SUITE("exercise 4.4") {
+    TEST_CASE("nearest hit equals brute force on a triangle soup") {
+        Mesh m = triangleSoup(2000, 11);
+        Bvh bvh = buildBvh(m, optionsFor(BvhBuilder::SweepSah));
+        size_t hits = 0;
+        for (const Ray& ray : randomRays(2000, 12)) {
+            double tTree, tBrute;
+            uint32_t a = nearestWithReference(bvh, ray, tTree);
+            uint32_t b = bruteWithReference(m, ray, tBrute);
+            hits += b != kNoPrimitive;
+            CHECK((a == b || tTree == tBrute));
+        }
+        CHECK(hits > 200);
+    }
+    TEST_CASE("the nearer child first and early out: a hit skips the far box") {
+        // Root with two leaves, the far one stored first (left): the ray along -z from
+        // z = 10 meets the right child's triangle at t = 1, and must not open the left one
+        // (its box starts at t = 5).
+        Bvh bvh;
+        bvh.nodes.resize(3);
+        bvh.nodes[0] = {Vec3(-1, -1, 0), 1, Vec3(1, 1, 9), 0};
+        bvh.nodes[1] = {Vec3(-1, -1, 0), 0, Vec3(1, 1, 5), 1};  // far leaf, slot 0
+        bvh.nodes[2] = {Vec3(-1, -1, 9), 1, Vec3(1, 1, 9), 1};  // near leaf, slot 1
+        bvh.primitiveIndices = {0, 1};
+        std::vector<uint32_t> calls;
+        Ray ray(Vec3(0.2f, 0.1f, 10.0f), Vec3(0, 0, -1));
+        float tClosest = ray.tmax;
+        uint32_t slot =
+            traverseNearest(bvh, TraversalRay(ray), tClosest, [&](uint32_t s, float& tmax) {
+                calls.push_back(s);
+                float t = s == 1 ? 1.0f : 7.0f;  // the near leaf's primitive at z = 9
+                if (t > tmax) return false;
+                tmax = t;
+                return true;
+            });
+        CHECK(slot == 1);
+        CHECK(tClosest == 1.0f);
+        CHECK(calls == std::vector<uint32_t>{1});
+    }
+    TEST_CASE("a miss of the root box tests nothing and an empty tree misses") {
+        Mesh m = triangleSoup(100, 13);
+        Bvh bvh = buildBvh(m, optionsFor(BvhBuilder::SweepSah));
+        int calls = 0;
+        float t = kInfinity<float>;
+        Ray away(Vec3(5.0f), Vec3(1.0f, 0.0f, 0.0f));
+        auto count = [&](uint32_t, float&) { return ++calls < 0; };
+        CHECK(traverseNearest(bvh, TraversalRay(away), t, count) == kTraversalMiss);
+        CHECK(calls == 0);
+        CHECK(traverseNearest(Bvh{}, TraversalRay(away), t, count) == kTraversalMiss);
+    }
+    TEST_CASE("hard case: axis-parallel rays with origins on slab planes") {
+        // Unit boxes on a grid; rays along +x with origins exactly on box faces (y, z on
+        // the planes): 0 * infinity in the slab test must not lose the hit.
+        Mesh m;
+        for (int i = 0; i < 4; ++i) {
+            float x = float(i) * 2.0f;
+            uint32_t base = uint32_t(m.positions.size());
+            m.positions.insert(m.positions.end(), {Vec3(x, 0, 0), Vec3(x, 1, 0), Vec3(x, 0, 1)});
+            m.triangles.push_back({base, base + 1, base + 2});
+        }
+        Bvh bvh = buildBvh(m, optionsFor(BvhBuilder::SweepSah));
+        for (float y : {0.0f, 0.25f}) {
+            for (Vec3 dir : {Vec3(1.0f, 0.0f, 0.0f), Vec3(1.0f, -0.0f, -0.0f)}) {
+                Ray ray(Vec3(-1.0f, y, 0.25f), dir);
+                double t;
+                uint32_t tri = nearestWithReference(bvh, ray, t);
+                CHECK(tri == 0);
+                CHECK(t == 1.0);
+            }
+        }
+    }
+}
+
+TEST_SUITE("exercise 4.5") {
+    TEST_CASE("any hit agrees with brute force") {
+        Mesh m = triangleSoup(1500, 14);
+        Bvh bvh = buildBvh(m, optionsFor(BvhBuilder::SweepSah));
+        size_t blocked = 0;
+        std::mt19937_64 rng(15);
+        std::uniform_real_distribution<float> len(0.05f, 1.0f);
+        for (Ray ray : randomRays(1500, 16)) {
+            ray.tmax = len(rng);  // shadow rays of finite length
+            bool tree = traverseAny(bvh, TraversalRay(ray), [&](uint32_t s, float) {
+                double t;
+                return referenceTriangle(ray, bvh.leafTriangles[s], t);
+            });
+            double t;
+            bool brute = bruteWithReference(m, ray, t) != kNoPrimitive;
+            blocked += brute;
+            CHECK(tree == brute);
+        }
+        CHECK(blocked > 100);
+    }
+    TEST_CASE("any hit stops at the first hit") {
+        Mesh m = triangleSoup(500, 17, 0.5f);  // large overlapping triangles: many hits
+        Bvh bvh = buildBvh(m, optionsFor(BvhBuilder::SweepSah));
+        Ray ray(Vec3(0.5f, 0.5f, -1.0f), Vec3(0, 0, 1));
+        int calls = 0, hitsSeen = 0;
+        bool any = traverseAny(bvh, TraversalRay(ray), [&](uint32_t s, float) {
+            ++calls;
+            double t;
+            bool hit = referenceTriangle(ray, bvh.leafTriangles[s], t);
+            hitsSeen += hit;
+            return hit;
+        });
+        CHECK(any);
+        CHECK(hitsSeen == 1);
+    }
+}
+
+TEST_SUITE("exercise 4.6") {
+    TEST_CASE("frustum of a 90 degree camera at the origin: corners and planes") {
+        Frustum f = makeFrustum(frustumCamera(), 1.0f, 100.0f);
+        Frustum expected = handFrustum();
+        for (size_t i = 0; i < 8; ++i) test::checkVec(f.corners[i], expected.corners[i], 1e-3);
+        for (size_t i = 0; i < 6; ++i) {
+            INFO("plane " << i);
+            test::checkVec(f.planes[i].normal, expected.planes[i].normal, 1e-5);
+            CHECK(f.planes[i].d == doctest::Approx(expected.planes[i].d).epsilon(1e-5));
+        }
+    }
+    TEST_CASE("points inside and outside a general frustum") {
+        Camera c;
+        c.eye = Vec3(1, 2, 3);
+        c.view = Vec3(1, 0, 1);
+        c.fovYDegrees = 50.0f;
+        c.aspect = 2.0f;
+        Frustum f = makeFrustum(c, 0.5f, 20.0f);
+        auto inside = [&](Vec3 p) {
+            for (const auto& pl : f.planes)
+                if (glm::dot(pl.normal, p) + pl.d < -1e-4f) return false;
+            return true;
+        };
+        Vec3 forward = glm::normalize(c.view);
+        CHECK(inside(c.eye + 10.0f * forward));
+        CHECK_FALSE(inside(c.eye + 0.25f * forward));  // before near
+        CHECK_FALSE(inside(c.eye + 21.0f * forward));  // beyond far
+        CHECK_FALSE(inside(c.eye - 5.0f * forward));   // behind
+        for (const Vec3& corner : f.corners) CHECK(inside(corner));
+        for (const auto& pl : f.planes) CHECK(glm::length(pl.normal) == doctest::Approx(1.0));
+        CHECK_THROWS_AS(makeFrustum(c, 0.0f, 1.0f), std::invalid_argument);
+        CHECK_THROWS_AS(makeFrustum(c, 2.0f, 1.0f), std::invalid_argument);
+    }
+}
+
+TEST_SUITE("exercise 4.7") {
+    TEST_CASE("p-vertex: outside one plane culled, straddling and inside kept") {
+        Frustum f = handFrustum();
+        CHECK(cullByPlanes(f, {Vec3(-1, -1, 1), Vec3(1, 1, 3)}));        // behind the eye
+        CHECK(cullByPlanes(f, {Vec3(-1, -1, -300), Vec3(1, 1, -200)}));  // beyond far
+        CHECK(cullByPlanes(f, {Vec3(60, -1, -50), Vec3(70, 1, -40)}));   // right of it
+        CHECK_FALSE(cullByPlanes(f, {Vec3(-1, -1, -20), Vec3(1, 1, -10)}));
+        CHECK_FALSE(cullByPlanes(f, {Vec3(40, -1, -50), Vec3(60, 1, -40)}));  // straddles
+        CHECK_FALSE(cullByPlanes(f, {Vec3(-1000), Vec3(1000)}));              // contains it
+    }
+    TEST_CASE("hard case: the box near a frustum corner is kept by the plane test") {
+        // x in [101, 105] beyond the far corners' x = 100, z in [-110, -95]: for the right
+        // plane the p-vertex (101, 1, -110) has -x - z = 9 >= 0; for the far plane z = -95
+        // is in front of -100. No plane rejects it: conservatively kept.
+        Frustum f = handFrustum();
+        Bounds3f box(Vec3(101, -1, -110), Vec3(105, 1, -95));
+        CHECK_FALSE(cullByPlanes(f, box));
+        CHECK_FALSE(boxIntersectsFrustumExact(f, box));  // yet entirely outside
+    }
+}
+
+TEST_SUITE("exercise 4.8") {
+    TEST_CASE("hard case: the refinement culls the box near the frustum corner") {
+        Frustum f = handFrustum();
+        // Every frustum corner has x <= 100 < 101 = the box's min x.
+        CHECK(cullByBoxPlanes(f, {Vec3(101, -1, -110), Vec3(105, 1, -95)}));
+    }
+    TEST_CASE("corners against box planes: boxes the frustum reaches are kept") {
+        Frustum f = handFrustum();
+        CHECK_FALSE(cullByBoxPlanes(f, {Vec3(-1, -1, -20), Vec3(1, 1, -10)}));
+        CHECK_FALSE(cullByBoxPlanes(f, {Vec3(-1000), Vec3(1000)}));
+        CHECK_FALSE(cullByBoxPlanes(f, {Vec3(99, 99, -101), Vec3(101, 101, -99)}));  // a corner
+        CHECK(cullByBoxPlanes(f, {Vec3(-5, 120, -50), Vec3(5, 130, -40)}));  // above every corner
+        CHECK(cullByBoxPlanes(f, {Vec3(-5, -5, -150), Vec3(5, 5, -120)}));   // beyond far
+    }
+}
+
+TEST_SUITE("culling 04") {
+    TEST_CASE("hierarchy culling keeps every triangle inside the frustum") {
+        // Uses the hand-made frustum and both culling exercises through boxCulled.
+        Mesh m = triangleSoup(3000, 18, 0.02f);
+        for (Vec3& p : m.positions) p = p * 200.0f - Vec3(100.0f, 100.0f, 150.0f);
+        Bvh bvh = buildBvh(m, optionsFor(BvhBuilder::SweepSah));
+        Frustum f = handFrustum();
+        for (CullTest test : {CullTest::Planes, CullTest::PlanesAndCorners}) {
+            CullCounts counts;
+            std::vector<uint32_t> visible = cullHierarchy(bvh, f, test, &counts);
+            std::set<uint32_t> kept(visible.begin(), visible.end());
+            size_t inside = 0;
+            for (size_t i = 0; i < m.triangleCount(); ++i) {
+                Bounds3f b;
+                for (int k = 0; k < 3; ++k) b.extend(m.vertex(i, k));
+                if (!boxIntersectsFrustumExact(f, b)) continue;
+                ++inside;
+                CHECK(kept.count(uint32_t(i)) == 1);
+            }
+            CHECK(inside > 100);
+            CHECK(counts.culled > 0);
+            CHECK(counts.visited == counts.culled + counts.kept);
+            CHECK(kept.size() < m.triangleCount());
+        }
+    }
+}
+
+TEST_SUITE("trace 04") {
+    TEST_CASE("rays and hits files round-trip") {
+        test::TempDir dir;
+        std::vector<Ray> rays = {Ray(Vec3(1, 2, 3), Vec3(0, -0.0f, 1), 0.5f, 7.0f),
+                                 Ray(Vec3(-1e30f, 0, 0), Vec3(1e-30f, 2, 0))};
+        writeRays(dir.file("r.bin"), rays);
+        CHECK(std::filesystem::file_size(dir.file("r.bin")) == 64);
+        std::vector<Ray> back = readRays(dir.file("r.bin"));
+        REQUIRE(back.size() == 2);
+        for (size_t i = 0; i < 2; ++i) {
+            CHECK(back[i].origin == rays[i].origin);
+            CHECK(back[i].direction == rays[i].direction);
+            CHECK(back[i].tmin == rays[i].tmin);
+            CHECK(back[i].tmax == rays[i].tmax);
+        }
+        CHECK(std::signbit(back[0].direction.y));
+        std::vector<TraceHit> hits = {{1.5f, 7u}, {}};
+        writeHits(dir.file("h.bin"), hits);
+        CHECK(readHits(dir.file("h.bin")) == hits);
+        // The bytes: little-endian float32 1.5 = 0x3FC00000, then uint32 7; a miss is
+        // +infinity (0x7F800000) and 0xFFFFFFFF.
+        std::string bytes = test::readText(dir.file("h.bin"));
+        REQUIRE(bytes.size() == 16);
+        CHECK(bytes.substr(0, 8) == std::string("\x00\x00\xC0\x3F\x07\x00\x00\x00", 8));
+        CHECK(bytes.substr(8, 8) == std::string("\x00\x00\x80\x7F\xFF\xFF\xFF\xFF", 8));
+    }
+    TEST_CASE("bad rays files are refused with the reason") {
+        test::TempDir dir;
+        std::ofstream(dir.file("short.bin"), std::ios::binary) << std::string(33, '\0');
+        CHECK_THROWS_WITH_AS(readRays(dir.file("short.bin")), doctest::Contains("multiple of 32"),
+                             InputError);
+        float nan[8] = {0, 0, 0, 0, 1, std::nanf(""), 0, 1};
+        std::ofstream(dir.file("nan.bin"), std::ios::binary)
+            .write(reinterpret_cast<const char*>(nan), sizeof(nan));
+        CHECK_THROWS_WITH_AS(readRays(dir.file("nan.bin")), doctest::Contains("NaN"), InputError);
+        CHECK_THROWS_AS(readRays(dir.file("none.bin")), InputError);
+    }
+    TEST_CASE("the hierarchy equals brute force on a real mesh") {
+        Mesh sh1 = loadObj(test::dataDir() + "/meshes/sh1.obj");
+        for (BvhBuilder b : kExerciseBuilders) {
+            Bvh bvh = buildBvh(sh1, optionsFor(b));
+            for (RayKind kind : {RayKind::Primary, RayKind::Diffuse, RayKind::Random}) {
+                INFO(bvhBuilderName(b) << " " << rayKindName(kind));
+                std::vector<Ray> rays = makeRays(sh1, kind, 400, 19);
+                size_t differ = 0, hits = 0;
+                for (const Ray& r : rays) {
+                    TraceHit tree = traceNearest(bvh, r), brute = traceBruteForce(sh1, r);
+                    differ += !hitsAgree(tree, brute);
+                    hits += brute.triangle != kNoPrimitive;
+                    CHECK(traceOccluded(bvh, r) == (brute.triangle != kNoPrimitive));
+                }
+                CHECK(differ == 0);
+                CHECK(hits > 40);
+            }
+        }
+    }
+    TEST_CASE("the fast leaf test agrees with a double-precision reference") {
+        Mesh m = triangleSoup(300, 20, 0.3f);
+        size_t hits = 0;
+        for (const Ray& r : randomRays(300, 21)) {
+            TraceHit fast = traceBruteForce(m, r);
+            double t;
+            uint32_t ref = bruteWithReference(m, r, t);
+            hits += ref != kNoPrimitive;
+            if (fast.triangle != ref)
+                CHECK(std::abs(double(fast.t) - t) < 1e-4 * (1.0 + t));
+            else if (ref != kNoPrimitive)
+                CHECK(double(fast.t) == doctest::Approx(t).epsilon(1e-5));
+        }
+        CHECK(hits > 50);
+    }
+}
+
+TEST_SUITE("program 04") {
+    const std::string program = BOXES_PROGRAM;
+
+    TEST_CASE("headless render writes a PNG of the requested size and the culling map") {
+        test::TempDir dir;
+        auto run = test::runProgram(
+            program, "--headless --scene sh1 --width 64 --height 40 --out a.png", dir);
+        INFO(run.err);
+        REQUIRE(run.exitCode == 0);
+        CHECK(test::pngSize(dir.file("a.png")) == std::pair{64, 40});
+        CHECK(test::pngSize(dir.file("a-cull.png")) == std::pair{64, 40});
+    }
+    TEST_CASE("measurements: the JSON report has the step tables") {
+        test::TempDir dir;
+        auto run = test::runProgram(program,
+                                    "--headless --scene sh1 --width 32 --height 24 --out a.png "
+                                    "--measure --measure-rays 400 --crack-rays 100 --report r.json",
+                                    dir);
+        INFO(run.err);
+        REQUIRE(run.exitCode == 0);
+        std::string json = test::readText(dir.file("r.json"));
+        for (const char* id :
+             {"bvh_build", "bvh_trace", "bvh_threads", "bvh_cracks", "bvh_culling", "bvh_tradeoff"})
+            CHECK(json.find(std::string("\"") + id + "\"") != std::string::npos);
+    }
+    TEST_CASE("trace command: hits equal brute force and the JSON line") {
+        test::TempDir dir;
+        Mesh sh1 = loadObj(test::dataDir() + "/meshes/sh1.obj");
+        std::vector<Ray> rays = makeRays(sh1, RayKind::Primary, 900, 3);
+        writeRays(dir.file("rays.bin"), rays);
+        for (const char* builder : {"midpoint", "median", "sah"}) {
+            INFO(builder);
+            auto run =
+                test::runProgram(program,
+                                 "trace --mesh " + test::dataDir() +
+                                     "/meshes/sh1.obj "
+                                     "--rays rays.bin --hits hits.bin --repeat 2 --builder " +
+                                     builder,
+                                 dir);
+            INFO(run.err);
+            REQUIRE(run.exitCode == 0);
+            CHECK(test::lineCount(run.out) == 1);
+            for (const char* key : {"\"tris\":3290", "\"rays\":900", "\"build_ms\"", "\"trace_ms\"",
+                                    "\"mrays_per_s\"", "\"hits\"", "\"threads\":1", "\"builder\""})
+                CHECK(run.out.find(key) != std::string::npos);
+            std::vector<TraceHit> hits = readHits(dir.file("hits.bin"));
+            REQUIRE(hits.size() == rays.size());
+            size_t hitCount = 0;
+            for (size_t i = 0; i < rays.size(); ++i) {
+                CHECK(hitsAgree(hits[i], traceBruteForce(sh1, rays[i])));
+                hitCount += hits[i].triangle != kNoPrimitive;
+            }
+            CHECK(hitCount > 100);
+            CHECK(run.out.find("\"hits\":" + std::to_string(hitCount)) != std::string::npos);
+        }
+    }
+    TEST_CASE("check command: real meshes against brute force with crack rays") {
+        test::TempDir dir;
+        auto run = test::runProgram(program,
+                                    "check --mesh " + test::dataDir() +
+                                        "/meshes/sh1.obj "
+                                        "--kind random --count 2000 --cracks 300",
+                                    dir);
+        INFO(run.out << run.err);
+        CHECK(run.exitCode == 0);
+        CHECK(run.out.find("\"ok\":true") != std::string::npos);
+        auto bunny = test::runProgram(program,
+                                      "check --mesh " + test::dataDir() +
+                                          "/meshes/bunny.obj "
+                                          "--kind diffuse --count 200 --cracks 100",
+                                      dir);
+        INFO(bunny.out << bunny.err);
+        CHECK(bunny.exitCode == 0);
+        CHECK(bunny.out.find("\"cracks\":0") != std::string::npos);
+    }
+    TEST_CASE("window: scripted frames with key presses under the offscreen video driver") {
+        test::TempDir dir;
+        auto run =
+            test::runProgram(program,
+                             "--scene sh1 --width 96 --height 48 --frames 5 --keys b,c,l,f,Left "
+                             "--screenshot shot.png",
+                             dir, "SDL_VIDEODRIVER=offscreen");
+        INFO(run.err);
+        REQUIRE(run.exitCode == 0);
+        CHECK(test::pngSize(dir.file("shot.png")).first > 0);
+    }
+    TEST_CASE("bad input: one clear line and a non-zero exit") {
+        test::TempDir dir;
+        std::string mesh = test::dataDir() + "/meshes/sh1.obj";
+        std::ofstream(dir.file("short.bin"), std::ios::binary) << std::string(40, '\0');
+        float nan[8] = {0, 0, 0, 0, 1, 0, std::nanf(""), 1};
+        std::ofstream(dir.file("nan.bin"), std::ios::binary)
+            .write(reinterpret_cast<const char*>(nan), sizeof(nan));
+        float good[8] = {0, 0, 0, 0, 1, 0, 0, 1};
+        std::ofstream(dir.file("good.bin"), std::ios::binary)
+            .write(reinterpret_cast<const char*>(good), sizeof(good));
+        struct Case {
+            std::string args, expect;
+            int code;
+        };
+        for (const Case& c : std::vector<Case>{
+                 {"trace --mesh " + mesh + " --rays short.bin --hits bad.bin", "multiple of 32", 1},
+                 {"trace --mesh " + mesh + " --rays nan.bin --hits bad.bin", "NaN", 1},
+                 {"trace --mesh missing.obj --rays good.bin --hits bad.bin", "no such file", 1},
+                 {"trace --mesh " + mesh + " --rays none.bin --hits bad.bin", "no such file", 1},
+                 {"trace --mesh " + mesh + " --rays good.bin --hits bad.bin --builder x", "builder",
+                  2},
+                 {"trace --mesh " + mesh + " --rays good.bin --hits bad.bin --threads 0", "threads",
+                  2},
+                 {"--headless --out bad.png --scene missing.obj", "no such file", 1},
+                 {"--headless --out bad.png --bins 1", "bins", 2}}) {
+            INFO(c.args);
+            auto run = test::runProgram(program, c.args, dir);
+            CHECK(run.exitCode == c.code);
+            CHECK(test::lineCount(run.err) == 1);
+            CHECK(run.err.find(c.expect) != std::string::npos);
+            CHECK_FALSE(std::filesystem::exists(dir.file("bad.bin")));
+            CHECK_FALSE(std::filesystem::exists(dir.file("bad.png")));
+        }
+    }
+}

@@ -1,0 +1,165 @@
+#!/usr/bin/python3
+"""Step 04 beside Intel Embree: the same rays, back to back, one thread each.
+
+usage: tools/bench04.py [--rays N] [--repeat K] [--meshes bunny,motorbike,oa_thor]
+                        [--out out/04_bvh_bench.json] [--data DIR] [--program PATH]
+
+For every mesh and ray kind (primary, diffuse, random) it writes one ray set with
+peer-bench's make_rays.py, runs peer-bench (Embree 3, one thread) and then our
+`04_bvh trace` with each builder on that file, each --repeat times (the programs report
+the median), and compares the hits ray by ray with Embree's. The interior map (oa_thor)
+gets its primary rays from the inside camera of the meshes README. Also: binned SAH on
+2 threads against 1, and the full-sweep SAH cost (the quality reference). Prints the
+table builder x ray kind x mesh and writes it as JSON (for the report).
+Needs: libembree-dev, python3-numpy (tools/deps.sh bench), the release build.
+"""
+import argparse
+import json
+import os
+import shutil
+import struct
+import subprocess
+import sys
+import tempfile
+
+ROOT = os.path.dirname(os.path.dirname(os.path.abspath(__file__)))
+PEER = "/work/shared/tools/peer-bench"
+INSIDE = ["--eye", "960,-384,2", "--look", "960,600,2", "--up", "0,0,1", "--fov", "90"]
+
+
+def run_json(cmd):
+    out = subprocess.run(cmd, check=True, capture_output=True, text=True)
+    return json.loads(out.stdout.strip().splitlines()[-1])
+
+
+def read_hits(path):
+    data = open(path, "rb").read()
+    return [struct.unpack_from("<fI", data, 8 * i) for i in range(len(data) // 8)]
+
+
+def agreement(ours, theirs):
+    same = sum(1 for a, b in zip(ours, theirs) if a[1] == b[1] or a[0] == b[0])
+    return same / max(1, len(ours))
+
+
+def main():
+    ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    ap.add_argument("--rays", type=int, default=250000)
+    ap.add_argument("--repeat", type=int, default=5)
+    ap.add_argument("--meshes", default="bunny,motorbike,oa_thor")
+    ap.add_argument("--data", default="/work/shared/data/meshes")
+    ap.add_argument("--out", default=os.path.join(ROOT, "out", "04_bvh_bench.json"))
+    ap.add_argument("--program", default=os.path.join(ROOT, "build/release/steps/04_bvh/04_bvh"))
+    ap.add_argument("--peer-dir", default=PEER)
+    a = ap.parse_args()
+
+    work = tempfile.mkdtemp(prefix="boxes-bench04-")
+    peer_src = os.path.join(work, "peer-bench")
+    shutil.copytree(a.peer_dir, peer_src)  # the shared folder is read-only
+    # Embree's own build script uses -march=native: that is Embree's side, ours stays portable.
+    subprocess.run(["sh", os.path.join(peer_src, "build.sh")], check=True, capture_output=True)
+    peer = os.path.join(peer_src, "peer-bench")
+    rows, threads, quality = [], [], []
+    for mesh in a.meshes.split(","):
+        obj = os.path.join(a.data, mesh + ".obj")
+        sweep = None
+        for kind in ("primary", "diffuse", "random"):
+            rays = os.path.join(work, "%s-%s.bin" % (mesh, kind))
+            extra = INSIDE if (mesh == "oa_thor" and kind == "primary") else []
+            subprocess.run(["/usr/bin/python3", os.path.join(peer_src, "make_rays.py"), obj, kind,
+                            str(a.rays), rays] + extra, check=True, capture_output=True)
+            ehits = os.path.join(work, "embree.bin")
+            emb = run_json([peer, obj, rays, ehits, "--threads", "1", "--repeat", str(a.repeat)])
+            eh = read_hits(ehits)
+            for builder in ("midpoint", "median", "sah"):
+                ohits = os.path.join(work, "ours.bin")
+                ours = run_json([a.program, "trace", "--mesh", obj, "--rays", rays, "--hits", ohits,
+                                 "--builder", builder, "--threads", "1", "--repeat", str(a.repeat)])
+                row = {"mesh": mesh, "kind": kind, "builder": builder,
+                       "mrays_per_s": ours["mrays_per_s"], "embree_mrays_per_s": emb["mrays_per_s"],
+                       "ratio": ours["mrays_per_s"] / emb["mrays_per_s"],
+                       "build_ms": ours["build_ms"], "embree_build_ms": emb["build_ms"],
+                       "sah_cost": ours["sah_cost"], "tris": ours["tris"], "rays": ours["rays"],
+                       "agree_with_embree": agreement(read_hits(ohits), eh)}
+                rows.append(row)
+                print("%-9s %-8s %-8s %7.3f Mrays/s  x%.2f Embree  build %8.1f ms  SAH %.2f  "
+                      "agree %.4f" % (mesh, kind, builder, row["mrays_per_s"], row["ratio"],
+                                      row["build_ms"], row["sah_cost"], row["agree_with_embree"]),
+                      file=sys.stderr)
+            if kind in ("primary", "diffuse"):
+                one = run_json([a.program, "trace", "--mesh", obj, "--rays", rays, "--hits", ohits,
+                                "--threads", "1", "--repeat", str(a.repeat)])
+                two = run_json([a.program, "trace", "--mesh", obj, "--rays", rays, "--hits", ohits,
+                                "--threads", "2", "--repeat", str(a.repeat)])
+                threads.append({"mesh": mesh, "kind": kind, "one": one["mrays_per_s"],
+                                "two": two["mrays_per_s"],
+                                "speedup": two["mrays_per_s"] / one["mrays_per_s"]})
+            if sweep is None:
+                sweep = run_json([a.program, "trace", "--mesh", obj, "--rays", rays, "--hits", ohits,
+                                  "--builder", "sweep-sah"])
+                sah = [r for r in rows if r["mesh"] == mesh and r["builder"] == "sah"][0]
+                quality.append({"mesh": mesh, "tris": sah["tris"], "sah_cost": sah["sah_cost"],
+                                "sweep_sah_cost": sweep["sah_cost"],
+                                "excess_pct": 100.0 * (sah["sah_cost"] / sweep["sah_cost"] - 1.0),
+                                "build_ms": sah["build_ms"],
+                                "s_per_mtri": sah["build_ms"] / 1e3 / (sah["tris"] / 1e6)})
+
+    print("\nStep 04 beside Embree 3 (one thread each, medians of %d runs, %d rays per set)"
+          % (a.repeat, a.rays))
+    print("%-10s %-8s %-9s %9s %9s %7s %10s %9s %8s" % ("mesh", "rays", "builder", "Mrays/s",
+          "Embree", "ratio", "build ms", "SAH cost", "agree"))
+    for r in rows:
+        print("%-10s %-8s %-9s %9.3f %9.3f %7.3f %10.1f %9.2f %8.4f" % (
+            r["mesh"], r["kind"], r["builder"], r["mrays_per_s"], r["embree_mrays_per_s"],
+            r["ratio"], r["build_ms"], r["sah_cost"], r["agree_with_embree"]))
+    print("\nBinned SAH against midpoint (primary rays):")
+    for mesh in a.meshes.split(","):
+        by = {r["builder"]: r for r in rows if r["mesh"] == mesh and r["kind"] == "primary"}
+        print("  %-10s %.2fx" % (mesh, by["sah"]["mrays_per_s"] / by["midpoint"]["mrays_per_s"]))
+    print("\nBuild and quality (binned SAH, 16 bins, one thread):")
+    for q in quality:
+        print("  %-10s %8d tris  %7.1f ms  %.3f s/Mtri  SAH %.2f vs sweep %.2f (+%.2f%%)" % (
+            q["mesh"], q["tris"], q["build_ms"], q["s_per_mtri"], q["sah_cost"],
+            q["sweep_sah_cost"], q["excess_pct"]))
+    print("\nThreads (binned SAH):")
+    for t in threads:
+        print("  %-10s %-8s 1: %.3f  2: %.3f  speed-up %.2fx" % (t["mesh"], t["kind"], t["one"],
+                                                                t["two"], t["speedup"]))
+    load = os.getloadavg()[0]
+    print("\n(load average during the run: %.1f on %d cores; ratios are back to back, the "
+          "absolute figures drift with the load)" % (load, os.cpu_count()))
+    os.makedirs(os.path.dirname(os.path.abspath(a.out)), exist_ok=True)
+    report = {"program": "04_bvh_bench", "images": [], "facts": {"load_average": os.getloadavg()[0]}, "rays": a.rays, "repeat": a.repeat, "load_average": load,
+              "tables": [
+                  {"id": "bench04_embree", "title": "Step 04 beside Embree 3: one thread each",
+                   "columns": ["mesh", "rays", "builder", "Mrays/s", "Embree Mrays/s", "ratio",
+                               "build ms", "SAH cost", "agree"],
+                   "rows": [[r["mesh"], r["kind"], r["builder"], r["mrays_per_s"],
+                             r["embree_mrays_per_s"], r["ratio"], r["build_ms"], r["sah_cost"],
+                             r["agree_with_embree"]] for r in rows],
+                   "note": "medians of %d runs each, back to back on the same ray file; 'agree': "
+                           "share of rays with Embree's triangle or t" % a.repeat},
+                  {"id": "bench04_build", "title": "Binned SAH build: time and quality",
+                   "columns": ["mesh", "tris", "build ms", "s/Mtri", "SAH cost", "sweep SAH cost",
+                               "excess %"],
+                   "rows": [[q["mesh"], q["tris"], q["build_ms"], q["s_per_mtri"], q["sah_cost"],
+                             q["sweep_sah_cost"], q["excess_pct"]] for q in quality], "note": ""},
+                  {"id": "bench04_threads", "title": "Two threads against one (binned SAH)",
+                   "columns": ["mesh", "rays", "1 thread", "2 threads", "speed-up"],
+                   "rows": [[t["mesh"], t["kind"], t["one"], t["two"], t["speedup"]]
+                            for t in threads], "note": ""},
+                  {"id": "bench04_tradeoff", "title": "Build time against trace speed",
+                   "columns": ["builder", "build ms", "Mrays/s"],
+                   "rows": [[r["mesh"] + " " + r["builder"], r["build_ms"], r["mrays_per_s"]]
+                            for r in rows if r["kind"] == "primary"], "note": "primary rays"}],
+              "plots": [{"table": "bench04_tradeoff", "x": "build ms", "y": "Mrays/s",
+                         "series": "builder", "logx": True,
+                         "title": "Builders: build time against trace speed (primary rays)"}]}
+    with open(a.out, "w") as f:
+        json.dump(report, f, indent=1)
+    print("wrote " + a.out)
+    shutil.rmtree(work, ignore_errors=True)
+
+
+if __name__ == "__main__":
+    main()

@@ -721,7 +721,7 @@ TEST_SUITE("program 04") {
             test::runProgram(program,
                              "--scene sh1 --width 96 --height 48 --frames 5 --keys b,c,l,f,Left "
                              "--screenshot shot.png",
-                             dir, "SDL_VIDEODRIVER=offscreen");
+                             dir, test::kWindowEnvironment);
         INFO(run.err);
         REQUIRE(run.exitCode == 0);
         CHECK(test::pngSize(dir.file("shot.png")).first > 0);

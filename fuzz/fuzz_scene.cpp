@@ -6,15 +6,25 @@
 #include "fuzz/fuzz_common.hpp"
 #include "fuzz/fuzz_scene_check.hpp"
 
+namespace {
+const boxes::SceneOptions kOptions{BOXES_FUZZ_DATA, 4.0f / 3.0f};
+}  // namespace
+
+// The mesh scenes are checked once here: re-reading a 2 MB OBJ per input made every
+// "bunny" input a (false) timeout under the fuzzer's instrumentation.
+extern "C" int LLVMFuzzerInitialize(int*, char***) {
+    for (const char* name : {"bunny", "sh1"})
+        boxes::fuzz::checkScene(boxes::makeScene(name, kOptions));
+    return 0;
+}
+
 extern "C" int LLVMFuzzerTestOneInput(const uint8_t* data, size_t size) {
     using namespace boxes;
     std::string name(reinterpret_cast<const char*>(data), size);
     if (name.find('/') != std::string::npos || name.find("..") != std::string::npos) return 0;
-    SceneOptions options;
-    options.dataDir = BOXES_FUZZ_DATA;
-    options.aspect = 4.0f / 3.0f;
+    if (name == "bunny" || name == "sh1") return 0;  // checked once, above
     try {
-        Scene scene = makeScene(name, options);
+        Scene scene = makeScene(name, kOptions);
         fuzz::checkScene(scene);
     } catch (const InputError& e) {
         fuzz::checkMessage(e.what());

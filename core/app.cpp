@@ -74,7 +74,7 @@ Vec3 parseVec3(const std::string& text, const std::string& flag) {
         size_t comma = rest.find(',');
         std::string field = i < 2 ? rest.substr(0, comma) : rest;
         if ((i < 2 && comma == std::string::npos) || field.empty())
-            throw InputError(flag + ": expected X,Y,Z, got '" + text + "'");
+            throw InputError(flag + ": expected X,Y,Z, got '" + printable(text) + "'");
         size_t used = 0;
         try {
             v[i] = std::stof(field, &used);
@@ -82,7 +82,7 @@ Vec3 parseVec3(const std::string& text, const std::string& flag) {
             used = 0;
         }
         if (used != field.size() || !std::isfinite(v[i]))
-            throw InputError(flag + ": '" + field + "' is not a finite number");
+            throw InputError(flag + ": '" + printable(field) + "' is not a finite number");
         if (i < 2) rest = rest.substr(comma + 1);
     }
     return v;

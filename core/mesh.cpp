@@ -6,8 +6,24 @@
 #include <filesystem>
 #include <fstream>
 #include <sstream>
+#include <string_view>
 
 namespace boxes {
+
+std::string printable(std::string_view text, size_t max) {
+    std::string out;
+    for (size_t i = 0; i < text.size(); ++i) {
+        if (out.size() >= max) return out + "...";
+        unsigned char c = static_cast<unsigned char>(text[i]);
+        if (c < 0x20 || c == 0x7f) {
+            const char* hex = "0123456789abcdef";
+            out += {'\\', 'x', hex[c >> 4], hex[c & 15]};
+        } else {
+            out += char(c);
+        }
+    }
+    return out;
+}
 
 void Mesh::computeVertexNormals() {
     normals.assign(positions.size(), Vec3(0.0f));
@@ -34,44 +50,75 @@ void Mesh::validate(const std::string& name) const {
     for (size_t t = 0; t < triangles.size(); ++t)
         for (uint32_t i : triangles[t])
             if (i >= positions.size())
-                throw InputError(name + ": triangle " + std::to_string(t) +
-                                 " uses vertex index " + std::to_string(i + 1) + " of only " +
+                throw InputError(name + ": triangle " + std::to_string(t) + " uses vertex index " +
+                                 std::to_string(i + 1) + " of only " +
                                  std::to_string(positions.size()));
     if (triangles.empty()) throw InputError(name + ": the mesh has no triangles");
 }
 
 namespace {
 
-// tinyobjloader reads a non-numeric coordinate as 0 without a word; check the vertex
-// lines ourselves so a malformed file is refused, not silently flattened.
-void checkVertexLines(const std::string& text, const std::string& name) {
-    std::istringstream in(text);
-    std::string line;
-    size_t lineNumber = 0;
-    while (std::getline(in, line)) {
+// Checks the text before tinyobjloader sees it, line by line as tinyobjloader splits
+// them ("\n", "\r" or "\r\n"; leading blanks skipped):
+// - vertex lines: tinyobjloader reads a non-numeric coordinate as 0 without a word, so a
+//   malformed file would be silently flattened;
+// - face lines: at most kMaxFaceVertices vertices (tinyobjloader's one-byte count);
+// - the totals: at most kMaxObjVertices vertices and kMaxObjTriangles triangles, counted
+//   here so memory is bounded before anything is allocated.
+void checkLines(std::string_view text, const std::string& name, const ObjLimits& limits) {
+    auto isBlank = [](char c) { return c == ' ' || c == '\t'; };
+    size_t lineNumber = 0, vertices = 0, triangles = 0;
+    size_t pos = 0;
+    while (pos < text.size()) {
+        size_t end = text.find_first_of("\r\n", pos);
+        if (end == std::string_view::npos) end = text.size();
+        std::string_view line = text.substr(pos, end - pos);
+        // "\r\n" is one line end, as in tinyobjloader.
+        pos = end + ((end + 1 < text.size() && text[end] == '\r' && text[end + 1] == '\n') ? 2 : 1);
         ++lineNumber;
-        if (line.size() < 2 || line[0] != 'v' || (line[1] != ' ' && line[1] != '\t')) continue;
-        std::istringstream fields(line.substr(2));
-        std::string field;
-        int count = 0;
-        while (fields >> field && count < 3) {
-            float value = 0.0f;
-            const char* end = field.data() + field.size();
-            auto [ptr, ec] = std::from_chars(field.data(), end, value);
-            if (ec == std::errc::result_out_of_range)
-                throw InputError(name + ":" + std::to_string(lineNumber) +
-                                 ": coordinate '" + field + "' is out of float range");
-            if (ec != std::errc() || ptr != end)
-                throw InputError(name + ":" + std::to_string(lineNumber) +
-                                 ": coordinate '" + field.substr(0, 40) + "' is not a number");
-            if (!std::isfinite(value))
-                throw InputError(name + ":" + std::to_string(lineNumber) + ": coordinate '" +
-                                 field.substr(0, 40) + "' is non-finite");
-            ++count;
+        size_t first = 0;
+        while (first < line.size() && isBlank(line[first])) ++first;
+        line.remove_prefix(first);
+        if (line.size() < 2 || !isBlank(line[1]) || (line[0] != 'v' && line[0] != 'f')) continue;
+        auto where = [&] { return name + ":" + std::to_string(lineNumber) + ": "; };
+        // Whitespace-separated fields after the keyword (tinyobjloader also splits at
+        // blanks only).
+        std::vector<std::string_view> fields;
+        for (size_t i = 1; i < line.size();) {
+            while (i < line.size() && isBlank(line[i])) ++i;
+            size_t j = i;
+            while (j < line.size() && !isBlank(line[j])) ++j;
+            if (j > i) fields.push_back(line.substr(i, j - i));
+            if (line[0] == 'v' && fields.size() == 3) break;
+            if (fields.size() > kMaxFaceVertices) break;
+            i = j;
         }
-        if (count < 3)
-            throw InputError(name + ":" + std::to_string(lineNumber) +
-                             ": a vertex needs 3 coordinates");
+        if (line[0] == 'f') {
+            if (fields.size() > kMaxFaceVertices)
+                throw InputError(where() + "a face of more than " +
+                                 std::to_string(kMaxFaceVertices) + " vertices");
+            if (fields.size() >= 3) triangles += fields.size() - 2;
+            if (triangles > limits.triangles)
+                throw InputError(name + ": more than " + std::to_string(limits.triangles) +
+                                 " triangles (the limit)");
+            continue;
+        }
+        for (std::string_view field : fields) {
+            float value = 0.0f;
+            const char* fieldEnd = field.data() + field.size();
+            auto [ptr, ec] = std::from_chars(field.data(), fieldEnd, value);
+            std::string shown = printable(field, 40);
+            if (ec == std::errc::result_out_of_range)
+                throw InputError(where() + "coordinate '" + shown + "' is out of float range");
+            if (ec != std::errc() || ptr != fieldEnd)
+                throw InputError(where() + "coordinate '" + shown + "' is not a number");
+            if (!std::isfinite(value))
+                throw InputError(where() + "coordinate '" + shown + "' is non-finite");
+        }
+        if (fields.size() < 3) throw InputError(where() + "a vertex needs 3 coordinates");
+        if (++vertices > limits.vertices)
+            throw InputError(name + ": more than " + std::to_string(limits.vertices) +
+                             " vertices (the limit)");
     }
 }
 
@@ -84,10 +131,10 @@ std::string firstLine(const std::string& s) {
 
 }  // namespace
 
-Mesh parseObj(const std::string& text, const std::string& name) {
+Mesh parseObj(const std::string& text, const std::string& name, const ObjLimits& limits) {
     if (text.find_first_not_of(" \t\r\n") == std::string::npos)
         throw InputError(name + ": the file is empty");
-    checkVertexLines(text, name);
+    checkLines(text, name, limits);
 
     tinyobj::ObjReaderConfig config;
     config.triangulate = false;  // we fan-triangulate ourselves, in file order
@@ -96,8 +143,8 @@ Mesh parseObj(const std::string& text, const std::string& name) {
     tinyobj::ObjReader reader;
     // An empty material text: the mesh's own materials are not used by the workbook.
     if (!reader.ParseFromString(text, "", config))
-        throw InputError(name + ": " + firstLine(reader.Error().empty() ? "cannot parse"
-                                                                        : reader.Error()));
+        throw InputError(name + ": " +
+                         firstLine(reader.Error().empty() ? "cannot parse" : reader.Error()));
     const tinyobj::attrib_t& attrib = reader.GetAttrib();
     Mesh mesh;
     size_t vertexCount = attrib.vertices.size() / 3;
@@ -125,21 +172,22 @@ Mesh parseObj(const std::string& text, const std::string& name) {
 }
 
 Mesh loadObj(const std::string& path) {
+    const std::string shown = printable(path, 200);  // a path in a message stays one line
     std::error_code ec;
-    if (!std::filesystem::exists(path, ec)) throw InputError(path + ": no such file");
-    if (std::filesystem::is_directory(path, ec)) throw InputError(path + ": is a directory");
+    if (!std::filesystem::exists(path, ec)) throw InputError(shown + ": no such file");
+    if (std::filesystem::is_directory(path, ec)) throw InputError(shown + ": is a directory");
     auto size = std::filesystem::file_size(path, ec);
-    if (ec) throw InputError(path + ": cannot read (" + ec.message() + ")");
+    if (ec) throw InputError(shown + ": cannot read (" + ec.message() + ")");
     if (size > kMaxObjBytes)
-        throw InputError(path + ": file of " + std::to_string(size >> 20) +
+        throw InputError(shown + ": file of " + std::to_string(size >> 20) +
                          " MiB is larger than the limit of " + std::to_string(kMaxObjBytes >> 20) +
                          " MiB");
     std::ifstream file(path, std::ios::binary);
-    if (!file) throw InputError(path + ": cannot open");
+    if (!file) throw InputError(shown + ": cannot open");
     std::string text(size, '\0');
     file.read(text.data(), std::streamsize(size));
-    if (!file) throw InputError(path + ": read failed");
-    return parseObj(text, path);
+    if (!file) throw InputError(shown + ": read failed");
+    return parseObj(text, shown);
 }
 
 }  // namespace boxes

@@ -6,6 +6,7 @@
 #include <cstdint>
 #include <stdexcept>
 #include <string>
+#include <string_view>
 #include <vector>
 
 #include "core/math.hpp"
@@ -16,6 +17,11 @@ namespace boxes {
 struct InputError : std::runtime_error {
     using std::runtime_error::runtime_error;
 };
+
+// User text quoted in such a message: control bytes escaped as \xNN so the message stays
+// one line (issue 10's fuzzing found names with newlines cutting messages short), and at
+// most `max` characters (then "...").
+std::string printable(std::string_view text, size_t max = 60);
 
 struct Mesh {
     std::vector<Vec3> positions;
@@ -32,11 +38,25 @@ struct Mesh {
 
 // Largest OBJ file we read (bytes); larger files are refused with a message.
 constexpr size_t kMaxObjBytes = size_t(1) << 30;
+// Counted before parsing, so a small file cannot ask for unbounded memory (a mesh at the
+// limits needs a few GiB): more vertices or triangles than this are refused.
+constexpr size_t kMaxObjVertices = size_t(1) << 25;
+constexpr size_t kMaxObjTriangles = size_t(1) << 25;
+// tinyobjloader stores a face's vertex count in one byte: larger faces are refused, not
+// silently cut (issue 10's fuzzing found a 300-vertex face becoming 42 wrong triangles).
+constexpr size_t kMaxFaceVertices = 255;
+
+struct ObjLimits {
+    size_t vertices = kMaxObjVertices;
+    size_t triangles = kMaxObjTriangles;
+};
 
 // Reads an OBJ file. Throws InputError for a missing, empty or malformed file (non-numeric
 // fields, indices out of range, no triangles, non-finite coordinates).
 Mesh loadObj(const std::string& path);
 // The same from text in memory (for tests and fuzzing).
-Mesh parseObj(const std::string& text, const std::string& name = "<memory>");
+// limits: lower ones for tests.
+Mesh parseObj(const std::string& text, const std::string& name = "<memory>",
+              const ObjLimits& limits = {});
 
 }  // namespace boxes

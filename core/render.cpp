@@ -1,10 +1,11 @@
 #include "core/render.hpp"
 
+#include <unistd.h>
+
 #include <cstdio>
 #include <mutex>
 #include <random>
 #include <thread>
-#include <unistd.h>
 
 #include "core/timing.hpp"
 
@@ -117,7 +118,11 @@ bool Renderer::needsShadowRay(int light, const SurfaceHit& hit) const {
     const Vec3 lightPos = scene_.lights[size_t(light)].position;
     for (int object : analysis_.occluders[size_t(light)]) {
         if (object == hit.object) {
-            if (!analysis_.convex[size_t(object)]) return true;
+            // A convex object cannot shadow a point of its outside; seen from inside (the
+            // camera in a sphere) it blocks every light beyond it (issue 10, hard case).
+            bool inside = glm::dot(hit.geometricNormal, lightPos - hit.point) < 0.0f &&
+                          !analysis_.isPlane[size_t(object)];
+            if (!analysis_.convex[size_t(object)] || inside) return true;
             continue;
         }
         if (analysis_.isPlane[size_t(object)]) {
@@ -205,12 +210,14 @@ Vec3 Renderer::pixel(int x, int y, RayCounts& counts) const {
     const int spp = settings_.samplesPerPixel;
     if (spp == 1) {
         ++counts.primary;
-        Ray ray(camera_.eye, camera_.directionThrough(basis_, float(x) + 0.5f, float(y) + 0.5f, w, h));
+        Ray ray(camera_.eye,
+                camera_.directionThrough(basis_, float(x) + 0.5f, float(y) + 0.5f, w, h));
         return trace(ray, 0, counts);
     }
     // Stratified samples: an n x n grid (n = ceil(sqrt(spp))), jittered, the first spp taken.
     int n = int(std::ceil(std::sqrt(double(spp))));
-    std::mt19937_64 rng(settings_.seed * 0x9E3779B97F4A7C15ull + uint64_t(y) * uint64_t(w) + uint64_t(x));
+    std::mt19937_64 rng(settings_.seed * 0x9E3779B97F4A7C15ull + uint64_t(y) * uint64_t(w) +
+                        uint64_t(x));
     std::uniform_real_distribution<float> uniform(0.0f, 1.0f);
     Vec3 sum(0.0f);
     for (int s = 0; s < spp; ++s) {

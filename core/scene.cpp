@@ -66,6 +66,26 @@ void Scene::checkRenderable() const {
         if (m < 0 || size_t(m) >= materials.size())
             throw std::logic_error("scene '" + name + "' uses a material that does not exist");
     };
+    // NaN or infinite geometry or lights would make NaN pixels (or trap): refuse them
+    // with a message naming the object (issue 10, hard cases).
+    auto bad = [&](const std::string& what, size_t i) {
+        return InputError("scene '" + printable(name) + "': " + what + " " + std::to_string(i) +
+                          " has a non-finite or invalid value");
+    };
+    for (size_t i = 0; i < spheres.size(); ++i) {
+        const Sphere& sphere = spheres[i].shape;
+        if (!isFinite(sphere.centre) || !std::isfinite(sphere.radius) || !(sphere.radius > 0.0f))
+            throw bad("sphere", i);
+    }
+    for (size_t i = 0; i < planes.size(); ++i)
+        if (!isFinite(planes[i].shape.normal) || isZero(planes[i].shape.normal) ||
+            !std::isfinite(planes[i].shape.d))
+            throw bad("plane", i);
+    for (size_t i = 0; i < lights.size(); ++i)
+        if (!isFinite(lights[i].position) || !isFinite(lights[i].intensity) ||
+            std::isnan(lights[i].radius) || !(lights[i].radius >= 0.0f))
+            throw bad("light", i);
+    if (hasMesh()) mesh.validate("scene '" + printable(name) + "' mesh");
     for (const auto& s : spheres) checkMaterial(s.material);
     for (const auto& p : planes) checkMaterial(p.material);
     for (const auto& g : geometries)
@@ -159,8 +179,8 @@ Scene smallLights() {
         for (int j = 0; j < 4; ++j) {
             Vec3 colour(0.6f + 0.1f * float(i % 3), 0.7f, 0.6f + 0.1f * float(j % 3));
             Vec3 intensity = 0.12f * colour;
-            s.lights.push_back(lightAt(Vec3(-4.0f + 2.0f * float(i), 0.9f, -3.5f + 2.0f * float(j)),
-                                       intensity));
+            s.lights.push_back(
+                lightAt(Vec3(-4.0f + 2.0f * float(i), 0.9f, -3.5f + 2.0f * float(j)), intensity));
         }
     return s;
 }
@@ -205,20 +225,28 @@ std::vector<std::pair<std::string, std::string>> builtinScenes() {
 Scene makeScene(const std::string& nameOrPath, const SceneOptions& options) {
     Scene s;
     const std::string meshes = options.dataDir + "/meshes/";
-    if (nameOrPath == "spheres") s = classicSpheres();
-    else if (nameOrPath == "diffuse") s = diffuseOnly();
-    else if (nameOrPath == "mirrors") s = mirrorsOnly();
-    else if (nameOrPath == "glass") s = glassOnly();
-    else if (nameOrPath == "single-sphere") s = singleSphere();
-    else if (nameOrPath == "small-lights") s = smallLights();
-    else if (nameOrPath == "bunny") s = meshScene("bunny", meshes + "bunny.obj", options.aspect, true);
-    else if (nameOrPath == "sh1") s = meshScene("sh1", meshes + "sh1.obj", options.aspect, false);
+    if (nameOrPath == "spheres")
+        s = classicSpheres();
+    else if (nameOrPath == "diffuse")
+        s = diffuseOnly();
+    else if (nameOrPath == "mirrors")
+        s = mirrorsOnly();
+    else if (nameOrPath == "glass")
+        s = glassOnly();
+    else if (nameOrPath == "single-sphere")
+        s = singleSphere();
+    else if (nameOrPath == "small-lights")
+        s = smallLights();
+    else if (nameOrPath == "bunny")
+        s = meshScene("bunny", meshes + "bunny.obj", options.aspect, true);
+    else if (nameOrPath == "sh1")
+        s = meshScene("sh1", meshes + "sh1.obj", options.aspect, false);
     else if (nameOrPath.size() > 4 && nameOrPath.ends_with(".obj"))
         s = meshScene(nameOrPath, nameOrPath, options.aspect, false);
     else {
         std::string names;
         for (const auto& [n, _] : builtinScenes()) names += (names.empty() ? "" : ", ") + n;
-        throw InputError("unknown scene '" + nameOrPath + "' (built-in: " + names +
+        throw InputError("unknown scene '" + printable(nameOrPath) + "' (built-in: " + names +
                          "; or a path ending in .obj)");
     }
     s.camera.aspect = options.aspect;

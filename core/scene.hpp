@@ -89,7 +89,8 @@ struct Scene {
     // Nearest hit over every object; false when nothing is hit in [tmin, tmax].
     bool intersect(const Ray& ray, SurfaceHit& hit) const;
     bool occluded(const Ray& ray) const;
-    // A scene with a mesh but no geometry for it cannot be rendered.
+    // A scene with a mesh but no geometry for it cannot be rendered (logic_error); NaN or
+    // infinite spheres, planes, lights or mesh vertices are refused (InputError).
     void checkRenderable() const;
 };
 

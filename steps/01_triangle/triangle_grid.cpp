@@ -1,6 +1,7 @@
 #include "01_triangle/triangle_grid.hpp"
 
 #include <algorithm>
+#include <cstdint>
 
 namespace boxes {
 
@@ -24,12 +25,29 @@ TriangleGrid::TriangleGrid(const Mesh& mesh, int material, TriangleTest test)
     float cellEdge = std::cbrt(volume / (2.0f * float(mesh.triangleCount())));
     for (int i = 0; i < 3; ++i)
         res_[i] = std::clamp(int(std::ceil(extent[i] / std::max(cellEdge, 1e-30f))), 1, 256);
-    cellSize_ = extent / Vec3(res_);
 
     auto cellOf = [&](Vec3 p) {
         glm::ivec3 c = glm::ivec3(glm::floor((p - lo_) / cellSize_));
         return glm::clamp(c, glm::ivec3(0), res_ - 1);
     };
+    // Bound the cell references: when triangles overlap many cells each (large or many
+    // identical triangles), N x cells entries would exhaust memory and overflow the 32-bit
+    // counts (issue 10: 10^5 copies of one triangle asked for about 10^10). Coarsen the
+    // grid until the references fit a budget proportional to N.
+    const size_t budget =
+        std::min<size_t>(16 * mesh.triangleCount() + (size_t(1) << 20), UINT32_MAX);
+    for (;;) {
+        cellSize_ = extent / Vec3(res_);
+        size_t references = 0;
+        for (size_t t = 0; t < mesh.triangleCount() && references <= budget; ++t) {
+            Vec3 a = mesh.vertex(t, 0), b = mesh.vertex(t, 1), c = mesh.vertex(t, 2);
+            glm::ivec3 span = cellOf(glm::max(a, glm::max(b, c)) + Vec3(pad)) -
+                              cellOf(glm::min(a, glm::min(b, c)) - Vec3(pad)) + 1;
+            references += size_t(span.x) * size_t(span.y) * size_t(span.z);
+        }
+        if (references <= budget || res_ == glm::ivec3(1)) break;
+        res_ = glm::max(res_ / 2, glm::ivec3(1));
+    }
     size_t cells = size_t(res_.x) * res_.y * res_.z;
     std::vector<uint32_t> counts(cells + 1, 0);
     auto forCells = [&](size_t tri, auto&& f) {
@@ -40,7 +58,8 @@ TriangleGrid::TriangleGrid(const Mesh& mesh, int material, TriangleTest test)
             for (int y = c0.y; y <= c1.y; ++y)
                 for (int x = c0.x; x <= c1.x; ++x) f((size_t(z) * res_.y + y) * res_.x + x);
     };
-    for (size_t t = 0; t < mesh.triangleCount(); ++t) forCells(t, [&](size_t cell) { ++counts[cell + 1]; });
+    for (size_t t = 0; t < mesh.triangleCount(); ++t)
+        forCells(t, [&](size_t cell) { ++counts[cell + 1]; });
     for (size_t i = 1; i <= cells; ++i) counts[i] += counts[i - 1];
     cellStart_ = counts;
     cellTriangles_.resize(counts[cells]);
@@ -67,7 +86,8 @@ void TriangleGrid::walk(const Ray& ray, Visit&& visit) const {
     }
     if (t0 > t1) return;
     Vec3 p = ray.at(t0);
-    glm::ivec3 cell = glm::clamp(glm::ivec3(glm::floor((p - lo_) / cellSize_)), glm::ivec3(0), res_ - 1);
+    glm::ivec3 cell =
+        glm::clamp(glm::ivec3(glm::floor((p - lo_) / cellSize_)), glm::ivec3(0), res_ - 1);
     glm::ivec3 step;
     Vec3 tNext, tDelta;
     for (int i = 0; i < 3; ++i) {

@@ -28,7 +28,7 @@ def exercises():
 
 def table_html(t):
     rows = "".join(
-        "<tr>" + "".join(f"<td>{html.escape(fmt(c))}</td>" for c in r) + "</tr>" for r in t["rows"]
+        "<tr>" + "".join((f"<td class=num>{html.escape(fmt(c))}</td>" if isinstance(c, (int, float)) else f"<td>{html.escape(fmt(c))}</td>") for c in r) + "</tr>" for r in t["rows"]
     )
     head = "".join(f"<th>{html.escape(c)}</th>" for c in t["columns"])
     note = f"<p class=note>{html.escape(t['note'])}</p>" if t.get("note") else ""
@@ -139,8 +139,8 @@ def main():
     nav = " | ".join(f"<a href='#{r['program']}'>{r['program']}</a>" for r in reports)
     page = f"""<!doctype html><html><head><meta charset=utf-8><title>Boxes workbook: the tour</title>
 <style>body{{font-family:sans-serif;max-width:1100px;margin:2em auto;color:#222}}
-table{{border-collapse:collapse;margin:.5em 0;font-size:90%}}td,th{{border:1px solid #ccc;padding:2px 8px;text-align:right}}
-td:first-child,th:first-child{{text-align:left}}tr.passed td{{background:#e8f6e8}}tr.failed td{{background:#fbe3e3}}
+table{{border-collapse:collapse;margin:.5em 0;font-size:90%}}td,th{{border:1px solid #ccc;padding:2px 8px;text-align:left}}td.num{{text-align:right}}
+tr.passed td{{background:#e8f6e8}}tr.failed td{{background:#fbe3e3}}
 figure{{display:inline-block;margin:.5em}}img{{max-width:640px;border:1px solid #ddd}}.note{{color:#666;font-size:85%}}</style></head>
 <body><h1>Boxes workbook: the tour</h1><p>Measured on {html.escape(machine)}. <a href='#exercises'>Exercises</a> | {nav}</p>{slides}
 {''.join(parts)}</body></html>"""

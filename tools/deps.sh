@@ -14,7 +14,7 @@ pkgs_for() {
       libtinyobjloader-dev libcli11-dev libimgui-dev nlohmann-json3-dev libgl-dev \
       libegl1 libgl1-mesa-dri
     ;;
-  test) echo python3 ;;
+  test) echo python3 python3-yaml ;;
   report) echo python3 python3-matplotlib ;;
   slides)
     echo chromium

@@ -16,12 +16,14 @@ import subprocess
 import sys
 
 sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
-from exercises import BEGIN, END, SOURCE_SUFFIXES, parse_file  # noqa: E402
+from exercises import BEGIN, END, SOURCE_SUFFIXES, exercises, parse_file  # noqa: E402
 
 ROOT = os.path.dirname(os.path.dirname(os.path.abspath(__file__)))
 SKIP_DIRS = {".git", "build", "out", "kit", "node_modules", "__pycache__"}
 # Grading belongs to the instructor's reference tree: it needs the solutions.
-NOT_IN_KIT = {"tools/grade.py", "tests/grading_test.py"}
+NOT_IN_KIT = {"tools/grade.py", "tests/grading_test.py", "tools/grade_class.py", "tools/class_bench.py",
+              "tools/gradescope.py", "tests/class_grading_test.py"}
+CLASSROOM_WORKFLOW = ".github/workflows/classroom.yml"  # GitHub Classroom (tools/classroom.py)
 
 
 def tracked_files(root):
@@ -118,6 +120,12 @@ def write_kit(dest, root=ROOT):
             stubbed += found
         else:
             shutil.copy2(src, dst)
+    # GitHub Classroom's autograding: one step per exercise with its points.
+    from classroom import workflow
+
+    os.makedirs(os.path.dirname(os.path.join(dest, CLASSROOM_WORKFLOW)), exist_ok=True)
+    with open(os.path.join(dest, CLASSROOM_WORKFLOW), "w", encoding="utf-8") as f:
+        f.write(workflow(exercises(root)))
     return stubbed
 
 

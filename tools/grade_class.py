@@ -1,0 +1,530 @@
+#!/usr/bin/python3
+"""Grades a whole class: a folder with one submission per student (a folder, a git
+repository or a .zip/.tar.* archive), in parallel, with the single-tree grader.
+
+usage: tools/grade_class.py SUBMISSIONS [--out DIR] [--jobs N] [--hidden DIR]
+                            [--steps 01,02] [--timeout S] [--student-timeout S]
+       (./workbook grade-class ...)
+
+Each submission is reduced to its step sources (tools/submissions.py: safe unpacking, size
+limits) and graded by tools/grade.py. Every worker (--jobs, default the number of cores) has
+its own grading folder (OUT/work/wN), primed once with the reference tree and reused for
+every student it grades, so a student costs the compile of their own step sources and the
+relink, not a build of the whole workbook.
+
+Written into OUT (default class-grades/): class.csv (student, points per exercise, total,
+build status, seconds), students/NAME/ (the points table, the JUnit XML, grade.json where the
+grader writes it, result.json), index.html (the distribution of points per exercise as a
+table and a plot, and the most common first failure per exercise) and cache.json. Progress
+goes to stderr. A run can be stopped (Ctrl-C) and started again: a submission whose graded
+sources hash to the same value as before (with the same reference, hidden tests and
+options) keeps its result and is not graded again.
+"""
+import argparse
+import collections
+import csv
+import fcntl
+import hashlib
+import html
+import json
+import os
+import signal
+import subprocess
+import sys
+import threading
+import time
+import xml.etree.ElementTree as ET
+from concurrent.futures import ThreadPoolExecutor, as_completed
+
+sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
+from exercises import exercises  # noqa: E402
+from kit import tracked_files  # noqa: E402
+from submissions import (SubmissionError, content_hash, is_submission, read_submission,  # noqa: E402
+                         stage, student_name)
+
+ROOT = os.path.dirname(os.path.dirname(os.path.abspath(__file__)))
+GRADE = os.path.join(ROOT, "tools", "grade.py")
+CACHE_VERSION = 1
+# What in tools/ decides a grade (besides the reference's sources, tests and CMake files).
+GRADER_FILES = ("tools/grade.py", "tools/exercises.py", "tools/kit.py", "tools/sandbox", "tools/submissions.py")
+
+
+def say(text):
+    print(f"[class] {text}", file=sys.stderr, flush=True)
+
+
+# The single-tree grader, as a command --------------------------------------------------------
+
+_grader_help = None
+
+
+def grader_has(option):
+    """Whether tools/grade.py knows an option (--json and --no-isolation came later: without
+    --json its JUnit XML is read)."""
+    global _grader_help
+    if _grader_help is None:
+        r = subprocess.run([sys.executable, GRADE, "--help"], capture_output=True, text=True)
+        _grader_help = r.stdout
+    return option in _grader_help
+
+
+_running = set()  # grade.py processes, killed on Ctrl-C or SIGTERM
+_running_lock = threading.Lock()
+
+
+def run_grader(tree, work, report_dir, steps=None, hidden=None, timeout=60.0, jobs=1,
+               no_sandbox=False, limit=None, lock_fd=None):
+    """Runs tools/grade.py on one tree into report_dir (points.txt, grade.xml, grade.json);
+    returns (exit code or None when it ran out of time, seconds)."""
+    os.makedirs(report_dir, exist_ok=True)
+    junit = os.path.join(report_dir, "grade.xml")
+    jsonf = os.path.join(report_dir, "grade.json")
+    for f in (junit, jsonf):
+        if os.path.exists(f):
+            os.remove(f)
+    cmd = [sys.executable, GRADE, tree, "--work", work, "--junit", junit, "--timeout", f"{timeout:g}",
+           "--jobs", str(jobs)]
+    if grader_has("--json"):
+        cmd += ["--json", jsonf]
+    if steps:
+        cmd += ["--steps", ",".join(steps)]
+    if hidden:
+        cmd += ["--hidden", hidden]
+    if no_sandbox:  # the grader's flag for running without bubblewrap, old or new
+        cmd += ["--no-isolation" if grader_has("--no-isolation") else "--no-sandbox"]
+    started = time.monotonic()
+    with open(os.path.join(report_dir, "points.txt"), "w") as out, \
+            open(os.path.join(report_dir, "grade.log"), "w") as err:
+        # Its own session, so a time-out kills the whole tree (ninja, the compiler, tests);
+        # the work folder's lock goes with it, so an orphan still holds the folder.
+        p = subprocess.Popen(cmd, stdout=out, stderr=err, stdin=subprocess.DEVNULL,
+                             start_new_session=True, pass_fds=(lock_fd,) if lock_fd is not None else ())
+        with _running_lock:
+            _running.add(p)
+        try:
+            code = p.wait(timeout=limit)
+        except subprocess.TimeoutExpired:
+            os.killpg(p.pid, signal.SIGKILL)
+            p.wait()
+            code = None
+        finally:
+            with _running_lock:
+                _running.discard(p)
+    return code, time.monotonic() - started
+
+
+def kill_running():
+    with _running_lock:
+        for p in list(_running):
+            try:
+                os.killpg(p.pid, signal.SIGKILL)
+            except ProcessLookupError:
+                pass
+
+
+def status_of_message(message):
+    """The status of a failed exercise from the JUnit message of the first grader."""
+    if "does not build" in message or "does not compile" in message:
+        return "does not compile"
+    if "timed out" in message:
+        return "time limit"
+    if "crashed" in message:
+        return "crashed"
+    return "failed"
+
+
+def load_results(report_dir, all_ex):
+    """[{exercise, title, step, points, max, passed, status, reason, details}] from the
+    grader's JSON (when it writes one) and JUnit XML; None when neither is there."""
+    rows = {}
+    junit = os.path.join(report_dir, "grade.xml")
+    if os.path.exists(junit):
+        try:
+            root = ET.parse(junit).getroot()
+        except ET.ParseError:
+            root = None
+        for case in root.iter("testcase") if root is not None else []:
+            ex = case.get("classname", "").split()[-1]
+            e = all_ex.get(ex)
+            failure = case.find("failure")
+            message = failure.get("message", "") if failure is not None else ""
+            text = (failure.text if failure is not None else case.findtext("system-out")) or ""
+            rows[ex] = {"exercise": ex, "title": e.title if e else "", "step": f"{int(ex.split('.')[0]):02d}",
+                        "max": e.points if e else 0, "passed": failure is None,
+                        "points": (e.points if e else 0) if failure is None else 0,
+                        "status": "passed" if failure is None else status_of_message(message),
+                        "reason": message, "details": [l for l in text.splitlines() if l.strip()],
+                        "seconds": float(case.get("time", "0") or 0)}
+    jsonf = os.path.join(report_dir, "grade.json")
+    if os.path.exists(jsonf):
+        try:
+            with open(jsonf) as f:
+                doc = json.load(f)
+        except (OSError, ValueError):
+            doc = {}
+        for item in doc.get("exercises", []):
+            ex = item["exercise"]
+            row = rows.setdefault(ex, {"exercise": ex, "details": []})
+            row.update({"title": item.get("title", row.get("title", "")),
+                        "step": item.get("step", f"{int(ex.split('.')[0]):02d}"),
+                        "max": item.get("max", 0), "points": item.get("points", 0),
+                        "passed": item.get("status") == "passed", "status": item.get("status", ""),
+                        "reason": item.get("reason", ""), "seconds": item.get("seconds", 0.0)})
+            if item.get("case") and item.get("status") != "passed" and item["case"] not in row["reason"]:
+                row["reason"] = f"{item['case']}: {row['reason']}"
+    if not rows:
+        return None
+    return sorted(rows.values(), key=lambda r: tuple(int(x) for x in r["exercise"].split(".")))
+
+
+# The class --------------------------------------------------------------------------------
+
+
+def config_hash(hidden, steps, timeout):
+    """What a grade depends on besides the student: the reference tree (tests, core, CMake,
+    grader), the hidden tests and the options."""
+    h = hashlib.sha256(f"v{CACHE_VERSION} steps={steps} timeout={timeout:g}\n".encode())
+    for rel in sorted(tracked_files(ROOT)):
+        if rel.startswith(("slides/", "out/", ".ci/")) or rel.endswith((".md", "_test.py")):
+            continue
+        if rel.startswith("tools/") and not rel.startswith(GRADER_FILES):
+            continue  # the class grader, the kit's extras, the report: not what grades
+        with open(os.path.join(ROOT, rel), "rb") as f:
+            h.update(rel.encode() + b"\0" + hashlib.sha256(f.read()).digest())
+    if hidden:
+        for n in sorted(os.listdir(hidden)):
+            p = os.path.join(hidden, n)
+            if os.path.isfile(p):
+                with open(p, "rb") as f:
+                    h.update(b"hidden/" + n.encode() + b"\0" + hashlib.sha256(f.read()).digest())
+    return h.hexdigest()
+
+
+class Workers:
+    """The grading folders OUT/work/wN, one per worker, each locked while in use (the lock
+    is inherited by grade.py, so even an orphaned grader keeps its folder)."""
+
+    def __init__(self, root, count):
+        self.root, self.free, self.cv = root, list(range(count)), threading.Condition()
+        self.fds = {}
+        for i in range(count):
+            os.makedirs(self.dir(i), exist_ok=True)
+            fd = os.open(os.path.join(self.dir(i), "lock"), os.O_RDWR | os.O_CREAT, 0o644)
+            try:
+                fcntl.flock(fd, fcntl.LOCK_EX | fcntl.LOCK_NB)
+            except BlockingIOError:
+                say(f"waiting for {self.dir(i)}: another grader still uses it")
+                fcntl.flock(fd, fcntl.LOCK_EX)
+            self.fds[i] = fd
+
+    def dir(self, i):
+        return os.path.join(self.root, f"w{i}")
+
+    def take(self):
+        with self.cv:
+            while not self.free:
+                self.cv.wait()
+            return self.free.pop(0)
+
+    def give(self, i):
+        with self.cv:
+            self.free.append(i)
+            self.cv.notify()
+
+    def close(self):
+        for fd in self.fds.values():
+            os.close(fd)
+
+
+def prime(workers, count, opts, key):
+    """Grades the reference tree in every worker folder that is not primed for this
+    configuration, in parallel: the core and the tests get built once per folder. Returns
+    the reference's result (it must have full points)."""
+    todo = []
+    for i in range(count):
+        stamp = os.path.join(workers.dir(i), "primed")
+        if not (os.path.exists(stamp) and open(stamp).read().strip() == key):
+            todo.append(i)
+    if not todo:
+        return None
+    say(f"priming {len(todo)} grading folder(s) with the reference tree (the core and the tests "
+        "are built once per folder; a few minutes)")
+    results = {}
+
+    def one(i):
+        report = os.path.join(workers.dir(i), "reference")
+        code, seconds = run_grader(ROOT, workers.dir(i), report,
+                                   opts.steps, opts.hidden, opts.timeout, opts.compile_jobs,
+                                   opts.no_sandbox, None, workers.fds[i])
+        rows = load_results(report, opts.all_ex)
+        results[i] = (code, rows, seconds)
+        if code == 0 and rows and all(r["passed"] for r in rows):
+            with open(os.path.join(workers.dir(i), "primed"), "w") as f:
+                f.write(key + "\n")
+
+    with ThreadPoolExecutor(len(todo)) as pool:
+        list(pool.map(one, todo))
+    for i, (code, rows, seconds) in results.items():
+        if code != 0 or not rows or not all(r["passed"] for r in rows):
+            failed = [f"{r['exercise']} ({r['reason']})" for r in rows or [] if not r["passed"]]
+            raise SystemExit(f"grade-class: the reference tree does not get full points in "
+                             f"{workers.dir(i)} (exit {code}; {', '.join(failed) or 'no results'}); "
+                             f"see {workers.dir(i)}/reference/")
+        say(f"primed {workers.dir(i)} in {seconds:.0f} s (the reference: full points)")
+    return results
+
+
+def grade_one(sub, workers, opts):
+    """Grades one submission: {student, hash, status, build, rows, total, seconds, ...}."""
+    result = {"student": sub["student"], "source": sub["entry"], "hash": sub["hash"]}
+    report = os.path.join(opts.out, "students", sub["student"])
+    if sub.get("error"):
+        result.update(status="error", build=f"not graded: {sub['error']}", rows=[], seconds=0.0)
+        return result
+    i = workers.take()
+    try:
+        tree = stage(sub["files"], os.path.join(workers.dir(i), "student"))
+        code, seconds = run_grader(tree, workers.dir(i), report, opts.steps,
+                                   opts.hidden, opts.timeout, opts.compile_jobs, opts.no_sandbox,
+                                   opts.student_timeout, workers.fds[i])
+    finally:
+        workers.give(i)
+    rows = load_results(report, opts.all_ex) if code == 0 else None
+    result["seconds"] = round(seconds, 2)
+    if code is None:
+        result.update(status="error", build=f"grading ran out of time ({opts.student_timeout:g} s)", rows=[])
+    elif code != 0 or rows is None:
+        with open(os.path.join(report, "grade.log"), errors="replace") as f:
+            last = (f.read().strip().splitlines() or [""])[-1]
+        result.update(status="error", build=f"the grader failed (exit {code}): {last[:200]}", rows=[])
+    else:
+        broken = sorted({r["step"] for r in rows if r["status"] == "does not compile"})
+        result.update(status="graded", rows=rows,
+                      build="ok" if not broken else "step " + ",".join(broken) + " does not compile")
+    result["total"] = sum(r["points"] for r in result["rows"])
+    with open(os.path.join(report, "result.json"), "w") as f:
+        json.dump(result, f, indent=1)
+    return result
+
+
+def discover(folder):
+    """[{student, entry, path}] of the submissions in a folder, by name."""
+    subs, names = [], set()
+    for entry in sorted(os.listdir(folder)):
+        path = os.path.join(folder, entry)
+        if entry.startswith(".") or not is_submission(path):
+            continue
+        name = student_name(entry)
+        if name in names or not name:
+            name = entry
+        names.add(name)
+        subs.append({"student": name, "entry": entry, "path": path})
+    return subs
+
+
+def write_csv(path, results, ex_list):
+    with open(path + ".tmp", "w", newline="") as f:
+        w = csv.writer(f)
+        w.writerow(["student"] + [e.id for e in ex_list] + ["total", "max", "build", "seconds"])
+        maximum = sum(e.points for e in ex_list)
+        for r in sorted(results, key=lambda r: r["student"]):
+            got = {row["exercise"]: row["points"] for row in r["rows"]}
+            w.writerow([r["student"]] + [got.get(e.id, 0) for e in ex_list] +
+                       [r.get("total", 0), maximum, r["build"], f"{r.get('seconds', 0):.1f}"])
+    os.replace(path + ".tmp", path)
+
+
+def write_summary(out, results, ex_list):
+    """index.html: per exercise the distribution of points (table and plot) and the most
+    common first failure."""
+    n = len(results)
+    graded = [r for r in results if r["status"] == "graded"]
+    rows_html, fractions = [], []
+    for e in ex_list:
+        got = [next((x for x in r["rows"] if x["exercise"] == e.id), None) for r in graded]
+        full = sum(1 for x in got if x and x["passed"])
+        reasons = collections.Counter()
+        for x in got:
+            if x and not x["passed"] and x["reason"]:
+                reasons[x["reason"]] += 1
+        common = reasons.most_common(1)
+        fractions.append((e.id, full, len(graded) - full))
+        mean = sum(x["points"] for x in got if x) / len(graded) if graded else 0.0
+        rows_html.append(
+            f"<tr><td>{e.id}</td><td class=t>{html.escape(e.title)}</td><td>{e.points}</td>"
+            f"<td>{full}</td><td>{len(graded) - full}</td><td>{mean:.2f}</td>"
+            f"<td class=t>{html.escape(common[0][0]) + f' <i>({common[0][1]}&times;)</i>' if common else ''}</td></tr>")
+    totals = [r.get("total", 0) for r in graded]
+    maximum = sum(e.points for e in ex_list)
+    plot = ""
+    try:
+        import matplotlib
+        matplotlib.use("Agg")
+        import matplotlib.pyplot as plt
+        fig, (a, b) = plt.subplots(1, 2, figsize=(12, max(3.5, 0.3 * len(ex_list))))
+        ids = [f[0] for f in fractions][::-1]
+        a.barh(ids, [f[1] for f in fractions][::-1], color="#4a8", label="full points")
+        a.barh(ids, [f[2] for f in fractions][::-1], left=[f[1] for f in fractions][::-1],
+               color="#d65", label="zero")
+        a.set_xlabel("students")
+        a.set_title("points per exercise")
+        a.legend(loc="upper center", bbox_to_anchor=(0.5, -0.15), ncol=2, frameon=False)
+        a.xaxis.get_major_locator().set_params(integer=True)
+        b.hist(totals, bins=range(0, maximum + 2), color="#48c", align="left")
+        b.set_xlabel(f"total points (of {maximum})")
+        b.set_ylabel("students")
+        b.set_title("total points")
+        b.yaxis.get_major_locator().set_params(integer=True)
+        fig.tight_layout()
+        fig.savefig(os.path.join(out, "points.png"), dpi=90)
+        plt.close(fig)
+        plot = '<p><img src="points.png" alt="points per exercise and total points"></p>'
+    except ImportError:
+        plot = "<p>(no plot: python3-matplotlib is missing; tools/deps.sh report)</p>"
+    failed_build = sum(1 for r in graded if r["build"] != "ok")
+    errors = [r for r in results if r["status"] != "graded"]
+    page = f"""<!doctype html><meta charset="utf-8"><title>Class grades</title>
+<style>body{{font:14px sans-serif;margin:2em}}td,th{{padding:2px 8px;text-align:right}}
+td.t{{text-align:left}}table{{border-collapse:collapse}}tr:nth-child(even){{background:#f4f4f4}}</style>
+<h1>Class grades</h1>
+<p>{n} submissions: {len(graded)} graded ({failed_build} with a step that does not compile),
+{len(errors)} not graded. Mean total {sum(totals) / len(totals) if totals else 0:.1f} of {maximum};
+median {sorted(totals)[len(totals) // 2] if totals else 0}. The table per student: <a href="class.csv">class.csv</a>.</p>
+{plot}
+<h2>Per exercise</h2>
+<table><tr><th>exercise</th><th class=t>what</th><th>points</th><th>full points</th><th>zero</th>
+<th>mean</th><th class=t>most common first failure</th></tr>
+{''.join(rows_html)}</table>
+{'<h2>Not graded</h2><ul>' + ''.join(f'<li>{html.escape(r["student"])}: {html.escape(r["build"])}</li>' for r in errors) + '</ul>' if errors else ''}
+"""
+    with open(os.path.join(out, "index.html"), "w") as f:
+        f.write(page)
+
+
+def grade_class(opts):
+    started = time.monotonic()
+    opts.out = os.path.abspath(opts.out)
+    os.makedirs(os.path.join(opts.out, "students"), exist_ok=True)
+    all_ex = exercises(ROOT)
+    numbers = sorted({f"{e.step:02d}" for e in all_ex})
+    opts.steps = [s.zfill(2) for s in opts.steps.split(",")] if opts.steps else None
+    bad = [s for s in opts.steps or [] if s not in numbers]
+    if bad:
+        raise SystemExit(f"grade-class: --steps {','.join(bad)}: no such step (steps: {','.join(numbers)})")
+    ex_list = [e for e in all_ex if not opts.steps or f"{e.step:02d}" in opts.steps]
+    opts.all_ex = {e.id: e for e in all_ex}
+    opts.hidden = os.path.abspath(opts.hidden) if opts.hidden else None
+    opts.jobs = max(1, opts.jobs)
+    opts.compile_jobs = max(1, (os.cpu_count() or 1) // opts.jobs)
+    key = config_hash(opts.hidden, opts.steps, opts.timeout)
+
+    subs = discover(opts.submissions)
+    if not subs:
+        raise SystemExit(f"grade-class: no submissions (folders or archives) in {opts.submissions}")
+    for s in subs:
+        try:
+            s["files"] = read_submission(s["path"])
+            s["hash"] = content_hash(s["files"])
+        except (SubmissionError, OSError) as e:
+            s["error"], s["hash"] = str(e), ""
+
+    cache_path = os.path.join(opts.out, "cache.json")
+    cache = {}
+    if os.path.exists(cache_path) and not opts.no_cache:
+        try:
+            with open(cache_path) as f:
+                doc = json.load(f)
+            if doc.get("config") == key:
+                cache = doc.get("results", {})
+            else:
+                say("the reference, hidden tests or options changed: grading every submission again")
+        except (OSError, ValueError):
+            pass
+    results, todo = {}, []
+    for s in subs:
+        old = cache.get(s["student"])
+        if old and old.get("hash") == s["hash"] and s["hash"] and old.get("status") == "graded":
+            results[s["student"]] = old
+        else:
+            todo.append(s)
+    say(f"{len(subs)} submissions: {len(results)} unchanged since the last run, {len(todo)} to grade "
+        f"with {opts.jobs} job(s)")
+    lock = threading.Lock()
+
+    def save():
+        with open(cache_path + ".tmp", "w") as f:
+            json.dump({"config": key, "results": results}, f)
+        os.replace(cache_path + ".tmp", cache_path)
+        write_csv(os.path.join(opts.out, "class.csv"), list(results.values()), ex_list)
+
+    def on_signal(signum, frame):
+        raise KeyboardInterrupt
+
+    signal.signal(signal.SIGTERM, on_signal)
+    workers = Workers(opts.work or os.path.join(opts.out, "work"), opts.jobs)
+    try:
+        p0 = time.monotonic()
+        if todo and any(not s.get("error") for s in todo):
+            prime(workers, min(opts.jobs, len(todo)), opts, key)
+        t0, done, failed_build = time.monotonic(), 0, 0
+        priming = t0 - p0
+        with ThreadPoolExecutor(opts.jobs) as pool:
+            futures = {pool.submit(grade_one, s, workers, opts): s for s in todo}
+            try:
+                for fut in as_completed(futures):
+                    r = fut.result()
+                    with lock:
+                        results[r["student"]] = r
+                        done += 1
+                        failed_build += r["build"] != "ok"
+                        save()
+                    left = len(todo) - done
+                    eta = (time.monotonic() - t0) / done * left if done else 0
+                    say(f"{done}/{len(todo)} graded, {failed_build} failed to build or to grade, "
+                        f"{left} remaining, ETA {eta / 60:.1f} min: {r['student']} "
+                        f"{r.get('total', 0)} points ({r['build']}, {r.get('seconds', 0):.0f} s)")
+            except KeyboardInterrupt:
+                for f in futures:
+                    f.cancel()
+                kill_running()
+                raise
+    except KeyboardInterrupt:
+        kill_running()
+        say(f"interrupted: {len(results)} results kept in {cache_path}; run the same command to go on")
+        return 130
+    finally:
+        workers.close()
+    save()
+    with open(os.path.join(opts.out, "run.json"), "w") as f:
+        json.dump({"jobs": opts.jobs, "graded": len(todo), "kept": len(subs) - len(todo),
+                   "priming_seconds": round(priming, 2),
+                   "grading_seconds": round(time.monotonic() - t0, 2)}, f, indent=1)
+    write_summary(opts.out, [results[s["student"]] for s in subs], ex_list)
+    say(f"done in {time.monotonic() - started:.0f} s: {opts.out}/class.csv, {opts.out}/index.html")
+    return 0
+
+
+def main(argv):
+    p = argparse.ArgumentParser(prog="./workbook grade-class", description=__doc__.split("\n\n")[0],
+                                epilog="\n\n".join(__doc__.split("\n\n")[2:]),
+                                formatter_class=argparse.RawDescriptionHelpFormatter)
+    p.add_argument("submissions", help="folder with one folder, git repository or archive per student")
+    p.add_argument("--out", default="class-grades", help="where the results go (default class-grades)")
+    p.add_argument("--jobs", type=int, default=os.cpu_count() or 1,
+                   help="students graded at once (default: the number of cores)")
+    p.add_argument("--hidden", help="folder of extra doctest files stepNN*.cpp (as for grade)")
+    p.add_argument("--steps", help="grade only these steps, e.g. 01,03")
+    p.add_argument("--timeout", type=float, default=60.0, help="seconds per test case (default 60)")
+    p.add_argument("--student-timeout", type=float, default=1800.0,
+                   help="seconds for one student's whole grading (default 1800)")
+    p.add_argument("--work", help="folder of the workers' grading folders (default OUT/work)")
+    p.add_argument("--no-cache", action="store_true", help="grade every submission again")
+    p.add_argument("--no-sandbox", action="store_true", help="run the tests without bubblewrap")
+    opts = p.parse_args(argv)
+    if not os.path.isdir(opts.submissions):
+        p.error(f"{opts.submissions}: no such folder")
+    return grade_class(opts)
+
+
+if __name__ == "__main__":
+    sys.exit(main(sys.argv[1:]))

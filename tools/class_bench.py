@@ -31,7 +31,6 @@ import shutil
 import subprocess
 import sys
 import tarfile
-import time
 import zipfile
 
 sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))

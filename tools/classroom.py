@@ -17,7 +17,6 @@ student's own repository, so a student can change them: the instructor's grade o
 comes from tools/grade.py, grade_class.py or the Gradescope bundle.
 """
 import os
-import re
 import subprocess
 import sys
 

@@ -12,7 +12,7 @@ its own grading folder (OUT/work/wN), primed once with the reference tree and re
 every student it grades, so a student costs the compile of their own step sources and the
 relink, not a build of the whole workbook.
 
-Written into OUT (default class-grades/): class.csv (student, points per exercise, total,
+Written into OUT (default build/class-grades/): class.csv (student, points per exercise, total,
 build status, seconds), students/NAME/ (the points table, the JUnit XML, grade.json where the
 grader writes it, result.json), index.html (the distribution of points per exercise as a
 table and a plot, and the most common first failure per exercise) and cache.json. Progress
@@ -69,6 +69,7 @@ def grader_has(option):
 
 
 _running = set()  # grade.py processes, killed on Ctrl-C or SIGTERM
+_stopping = threading.Event()  # set then: no new grade.py starts
 _running_lock = threading.Lock()
 
 
@@ -97,9 +98,11 @@ def run_grader(tree, work, report_dir, steps=None, hidden=None, timeout=60.0, jo
             open(os.path.join(report_dir, "grade.log"), "w") as err:
         # Its own session, so a time-out kills the whole tree (ninja, the compiler, tests);
         # the work folder's lock goes with it, so an orphan still holds the folder.
-        p = subprocess.Popen(cmd, stdout=out, stderr=err, stdin=subprocess.DEVNULL,
-                             start_new_session=True, pass_fds=(lock_fd,) if lock_fd is not None else ())
         with _running_lock:
+            if _stopping.is_set():
+                return -signal.SIGTERM, 0.0
+            p = subprocess.Popen(cmd, stdout=out, stderr=err, stdin=subprocess.DEVNULL,
+                                 start_new_session=True, pass_fds=(lock_fd,) if lock_fd is not None else ())
             _running.add(p)
         try:
             code = p.wait(timeout=limit)
@@ -114,6 +117,7 @@ def run_grader(tree, work, report_dir, steps=None, hidden=None, timeout=60.0, jo
 
 
 def kill_running():
+    _stopping.set()
     with _running_lock:
         for p in list(_running):
             try:
@@ -461,14 +465,15 @@ def grade_class(opts):
         raise KeyboardInterrupt
 
     signal.signal(signal.SIGTERM, on_signal)
-    workers = Workers(opts.work or os.path.join(opts.out, "work"), opts.jobs)
+    count = max(1, min(opts.jobs, len(todo)))  # no more workers than submissions to grade
+    workers = Workers(opts.work or os.path.join(opts.out, "work"), count)
     try:
         p0 = time.monotonic()
         if todo and any(not s.get("error") for s in todo):
-            prime(workers, min(opts.jobs, len(todo)), opts, key)
+            prime(workers, count, opts, key)
         t0, done, failed_build = time.monotonic(), 0, 0
         priming = t0 - p0
-        with ThreadPoolExecutor(opts.jobs) as pool:
+        with ThreadPoolExecutor(count) as pool:
             futures = {pool.submit(grade_one, s, workers, opts): s for s in todo}
             try:
                 for fut in as_completed(futures):
@@ -484,6 +489,7 @@ def grade_class(opts):
                         f"{left} remaining, ETA {eta / 60:.1f} min: {r['student']} "
                         f"{r.get('total', 0)} points ({r['build']}, {r.get('seconds', 0):.0f} s)")
             except KeyboardInterrupt:
+                _stopping.set()
                 for f in futures:
                     f.cancel()
                 kill_running()
@@ -509,7 +515,8 @@ def main(argv):
                                 epilog="\n\n".join(__doc__.split("\n\n")[2:]),
                                 formatter_class=argparse.RawDescriptionHelpFormatter)
     p.add_argument("submissions", help="folder with one folder, git repository or archive per student")
-    p.add_argument("--out", default="class-grades", help="where the results go (default class-grades)")
+    p.add_argument("--out", default=os.path.join(ROOT, "build", "class-grades"),
+                   help="where the results go (default build/class-grades)")
     p.add_argument("--jobs", type=int, default=os.cpu_count() or 1,
                    help="students graded at once (default: the number of cores)")
     p.add_argument("--hidden", help="folder of extra doctest files stepNN*.cpp (as for grade)")

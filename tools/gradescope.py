@@ -54,6 +54,11 @@ if [[ -z ${BOXES_SKIP_APT:-} ]]; then
   apt-get update
   "$source_dir/workbook/tools/deps.sh" build grade
 fi
+# The workbook needs CMake 3.25 and a C++20 compiler: Gradescope's Ubuntu 24.04 image.
+if ! cmake --version | awk 'NR == 1 { split($3, v, "."); exit !(v[1] > 3 || (v[1] == 3 && v[2] >= 25)) }'; then
+  echo "setup.sh: CMake $(cmake --version | awk 'NR == 1 { print $3 }') is too old: choose the Ubuntu 24.04 base image" >&2
+  exit 1
+fi
 # Grade the reference once: the core and the tests are built into the image, so a
 # submission costs only the compile of its own step sources.
 python3 "$source_dir/workbook/tools/gradescope.py" prime --root "$root"
@@ -245,7 +250,9 @@ def run(args):
         write({"score": 0, "output": "The grader failed (the instructor sees its log): "
                + ((log.strip().splitlines() or [""])[-1])[:300], "tests": []})
         return 0
-    notes = [l[len("note: "):] for l in table.splitlines() if l.startswith("note: ")]
+    # The students see the notes; which hidden test files there are is not for them.
+    notes = [l[len("note: "):] for l in table.splitlines()
+             if l.startswith("note: ") and not l.startswith("note: hidden tests")]
     if not isolated:
         notes.append("the tests ran in Gradescope's container without bubblewrap")
     write(results_json(rows, config, notes, time.monotonic() - started))

@@ -35,7 +35,7 @@ from gradescope import isolation_works  # noqa: E402
 from kit import CLASSROOM_WORKFLOW, write_kit  # noqa: E402
 
 failures = []
-TIMEOUT = "5"  # seconds per test case: the looping student costs it once per case
+TIMEOUT = "10"  # seconds per test case: the looping student costs it once per case
 
 
 def check(condition, message):

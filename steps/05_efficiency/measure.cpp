@@ -81,7 +81,8 @@ std::optional<T> mtT(const RayT<T>& ray, const Vec3T<T>& a, const Vec3T<T>& b, c
 
 }  // namespace
 
-std::vector<Timing> measureInterleaved(int repeats, const std::vector<std::function<void()>>& fns) {
+std::vector<std::vector<double>> sampleInterleaved(int repeats,
+                                                   const std::vector<std::function<void()>>& fns) {
     std::vector<std::vector<double>> samples(fns.size());
     for (int r = 0; r < repeats; ++r)
         for (size_t i = 0; i < fns.size(); ++i) {
@@ -89,8 +90,12 @@ std::vector<Timing> measureInterleaved(int repeats, const std::vector<std::funct
             fns[i]();
             samples[i].push_back(watch.seconds());
         }
+    return samples;
+}
+
+std::vector<Timing> measureInterleaved(int repeats, const std::vector<std::function<void()>>& fns) {
     std::vector<Timing> out;
-    for (auto& s : samples) out.push_back(summarize(s));
+    for (auto& s : sampleInterleaved(repeats, fns)) out.push_back(summarize(s));
     return out;
 }
 
@@ -821,25 +826,44 @@ Table measureThreads(const Scene& scene, const LabOptions& o) {
     Table t;
     t.id = "threads";
     t.title = "Threads: speed-up over one thread, and how the work is handed out";
-    t.columns = {"threads", "schedule", "ms/frame", "min ms", "max ms", "speed-up", "identical"};
+    t.columns = {"threads",  "schedule",     "ms/frame",     "min ms",   "max ms",
+                 "speed-up", "speed-up min", "speed-up max", "identical"};
     int all = int(std::max(1u, std::thread::hardware_concurrency()));
-    t.note = "scene '" + scene.name +
-             "', 320x240, median of repeats; speed-up against one thread with the "
-             "same schedule; this machine has " +
-             std::to_string(all) + " hardware threads (shared)";
+    const int repeats = std::max(o.repeats, 7);
+    t.note = "scene '" + scene.name + "', " + std::to_string(sized(o, 320)) + "x" +
+             std::to_string(sized(o, 240)) + ", " + std::to_string(repeats) +
+             " rounds; each round renders one frame of every row in turn (round-robin), and the "
+             "speed-up is per round (one thread's frame over this row's frame in the same round), "
+             "then its median, min and max: a change of the machine's load hits both frames of a "
+             "ratio alike; this machine has " +
+             std::to_string(all) + " hardware threads" + (all <= 2 ? " (so 'all' is 2)" : "") +
+             ", shared with other work";
     Renderer r(scene, scene.camera, oneThread(sized(o, 320), sized(o, 240)));
     Image ref = r.render();
     std::vector<int> counts = {1, 2};
     if (all > 2) counts.push_back(all);
-    for (Schedule s : {Schedule::StaticRows, Schedule::DynamicRows, Schedule::DynamicTiles}) {
-        double one = 0.0;
-        for (int n : counts) {
-            Image img;
-            Timing tm = measure(o.repeats, [&] { img = renderScheduled(r, n, s); });
-            if (n == 1) one = tm.median;
-            t.row({(long long)n, std::string(scheduleName(s)), ms(tm.median), ms(tm.min),
-                   ms(tm.max), one / tm.median, std::string(identical(img, ref) ? "yes" : "NO")});
-        }
+    struct Variant {
+        Schedule schedule;
+        int threads;
+        Image image;
+    };
+    std::vector<Variant> variants;
+    for (Schedule s : {Schedule::StaticRows, Schedule::DynamicRows, Schedule::DynamicTiles})
+        for (int n : counts) variants.push_back({s, n, Image()});
+    std::vector<std::function<void()>> frames;
+    for (Variant& v : variants)
+        frames.push_back([&r, &v] { v.image = renderScheduled(r, v.threads, v.schedule); });
+    std::vector<std::vector<double>> samples = sampleInterleaved(repeats, frames);
+    for (size_t i = 0; i < variants.size(); ++i) {
+        // The one-thread row of the same schedule comes first in its group.
+        size_t one = i - i % counts.size();
+        std::vector<double> ratios;
+        for (int k = 0; k < repeats; ++k)
+            ratios.push_back(samples[one][size_t(k)] / samples[i][size_t(k)]);
+        Timing tm = summarize(samples[i]), speedup = summarize(ratios);
+        t.row({(long long)variants[i].threads, std::string(scheduleName(variants[i].schedule)),
+               ms(tm.median), ms(tm.min), ms(tm.max), speedup.median, speedup.min, speedup.max,
+               std::string(identical(variants[i].image, ref) ? "yes" : "NO")});
     }
     return t;
 }

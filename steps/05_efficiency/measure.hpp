@@ -37,6 +37,9 @@ Table measurePreviews(const Scene& scene, const LabOptions& o);
 // Times each function `repeats` times, one call of each per round (round-robin), so a
 // drift in the machine's load is shared by all of them. One Timing per function.
 std::vector<Timing> measureInterleaved(int repeats, const std::vector<std::function<void()>>& fns);
+// The same, the raw samples: samples[i][round] in seconds (for ratios taken per round).
+std::vector<std::vector<double>> sampleInterleaved(int repeats,
+                                                   const std::vector<std::function<void()>>& fns);
 
 // How work is handed to threads.
 enum class Schedule { StaticRows, DynamicRows, DynamicTiles };

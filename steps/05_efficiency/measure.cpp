@@ -9,7 +9,7 @@
 #include <random>
 #include <thread>
 
-#include "05_efficiency/cluster_mesh.hpp"
+#include "05_efficiency/bvh_mesh.hpp"
 #include "05_efficiency/lab.hpp"
 #include "05_efficiency/progressive.hpp"
 #include "core/timing.hpp"
@@ -17,10 +17,6 @@
 namespace boxes {
 
 namespace {
-
-// Triangles per box in the lab's flat list of boxes: large enough that triangle tests,
-// not box tests, are most of the work (as they are behind a hierarchy).
-constexpr int kLabClusterSize = 128;
 
 // Image sizes and sample counts, reduced for a quick run.
 int sized(const LabOptions& o, int full) {
@@ -350,58 +346,76 @@ Table measureSinCos(const LabOptions& o) {
     return t;
 }
 
-Table measureEarlyOut(const Mesh& mesh, const LabOptions& o) {
+Table measureEarlyOut(LabBvhMesh& mesh, const LabOptions& o) {
     Table t;
     t.id = "early_out";
-    t.title = "Early out: triangle and box tests per ray and time, with and without";
-    t.columns = {"rays",   "method", "count", "box tests/ray", "triangle tests/ray",
-                 "us/ray", "min us", "max us"};
+    t.title = "Early out: box and triangle tests per ray and time, with and without";
+    t.columns = {"rays",   "method", "count",  "box tests/ray", "triangle tests/ray",
+                 "us/ray", "min us", "max us", "speed-up"};
     t.note =
-        "the mesh in 128-triangle clusters behind a flat list of boxes (no hierarchy); primary "
-        "rays "
-        "of an 80x60 view; shadow rays from their hits to the light; one thread, median of repeats";
-    ClusterMesh cm(mesh, 0, kLabClusterSize);
-    Bounds3f b(cm.boundsMin(), cm.boundsMax());
+        "the mesh in step 04's hierarchy (full-sweep SAH, leaves of at most 8 triangles), the "
+        "lab's own traversal; primary rays of an 80x60 view, shadow rays from their hits to the "
+        "light; one thread, median of repeats interleaved round-robin; speed-up: the first row of "
+        "each pair over the second";
+    const Bounds3f b(mesh.boundsMin(), mesh.boundsMax());
     Camera cam = fitCamera(b.min, b.max, 4.0f / 3.0f);
     CameraBasisT<float> basis = cam.basis();
     Vec3 light = b.centroid() + glm::length(b.diagonal()) * Vec3(0.6f, 1.2f, 0.9f);
     std::vector<Ray> primary, shadow;
     const int w = sized(o, 80), h = sized(o, 60);
+    mesh.setOptions({});
     for (int y = 0; y < h; ++y)
         for (int x = 0; x < w; ++x) {
             Ray r(cam.eye, cam.directionThrough(basis, x + 0.5f, y + 0.5f, w, h));
             primary.push_back(r);
             SurfaceHit hit;
-            if (cm.intersect(r, hit)) {
+            if (mesh.intersect(r, hit)) {
                 Vec3 d = light - hit.point;
                 shadow.emplace_back(offsetOrigin(hit.point, hit.geometricNormal, d), d, 0.0f, 1.0f);
             }
         }
-    auto run = [&](const std::string& kind, const std::string& method, const std::vector<Ray>& rays,
-                   ClusterMeshOptions opt, bool shadows) {
-        cm.setOptions(opt);
-        cm.resetCounters();
-        auto pass = [&] {
+    LabMeshOptions on, anyOff, skipOff;
+    anyOff.anyHitShadows = false;
+    skipOff.skipBeyondNearest = false;
+    struct Variant {
+        const char* kind;
+        const char* method;
+        const std::vector<Ray>* rays;
+        LabMeshOptions opt;
+        bool shadows;
+    };
+    const Variant variants[] = {
+        {"shadow", "any hit (stop at the first occluder)", &shadow, on, true},
+        {"shadow", "nearest hit, then 'is there one'", &shadow, anyOff, true},
+        {"primary", "nearer child first, skip nodes beyond the nearest t", &primary, on, false},
+        {"primary", "every node the ray meets, storage order", &primary, skipOff, false}};
+    std::vector<std::function<void()>> passes;
+    std::vector<double> boxes, tris;
+    for (const Variant& v : variants) {
+        auto pass = [&mesh, &v] {
+            mesh.setOptions(v.opt);
             int n = 0;
-            SurfaceHit h;
-            for (const Ray& r : rays) n += shadows ? cm.occluded(r) : cm.intersect(r, h);
+            SurfaceHit hit;
+            for (const Ray& r : *v.rays) n += v.shadows ? mesh.occluded(r) : mesh.intersect(r, hit);
             keepValue(n);
         };
+        mesh.resetCounters();
         pass();
-        double boxes = double(cm.boxTests()) / double(rays.size());
-        double tris = double(cm.triangleTests()) / double(rays.size());
-        Timing tm = measure(o.repeats, pass);
-        double per = 1e6 / double(rays.size());
-        t.row({kind, method, (long long)rays.size(), boxes, tris, tm.median * per, tm.min * per,
-               tm.max * per});
-    };
-    ClusterMeshOptions on, off;
-    off.anyHitShadows = false;
-    run("shadow", "any hit (stop at the first occluder)", shadow, on, true);
-    run("shadow", "nearest hit (boxes front to back)", shadow, off, true);
-    off.skipFarClusters = false;
-    run("primary", "boxes front to back, stop beyond nearest t", primary, on, false);
-    run("primary", "every box the ray meets, storage order", primary, off, false);
+        const double count = double(std::max<size_t>(1, v.rays->size()));
+        boxes.push_back(double(mesh.boxTests()) / count);
+        tris.push_back(double(mesh.triangleTests()) / count);
+        passes.push_back(pass);
+    }
+    std::vector<Timing> times = measureInterleaved(o.repeats, passes);
+    mesh.setOptions({});
+    for (size_t i = 0; i < std::size(variants); ++i) {
+        const Variant& v = variants[i];
+        double per = 1e6 / double(std::max<size_t>(1, v.rays->size()));
+        size_t first = i - i % 2;
+        t.row({std::string(v.kind), std::string(v.method), (long long)v.rays->size(), boxes[i],
+               tris[i], times[i].median * per, times[i].min * per, times[i].max * per,
+               times[first + 1].median / times[i].median});
+    }
     return t;
 }
 
@@ -504,7 +518,7 @@ Table measureEffects(const LabOptions& o) {
     return t;
 }
 
-Table measurePrecalculation(const Mesh& mesh, const LabOptions& o) {
+Table measurePrecalculation(LabBvhMesh& mesh, const LabOptions& o) {
     Table t;
     t.id = "precalc";
     t.title =
@@ -518,30 +532,32 @@ Table measurePrecalculation(const Mesh& mesh, const LabOptions& o) {
                  "triangle tests/pixel",
                  "pixels differing"};
     t.note =
-        "the mesh alone (no floor) in 128-triangle clusters behind a flat "
-        "list of boxes, 96x72, primary and shadow rays, one thread, median of repeats interleaved "
+        "the mesh alone (no floor) in step 04's hierarchy, the lab's traversal with each switch, "
+        "96x72, primary and shadow rays, one thread, median of repeats interleaved "
         "(one frame of each variant per round); pixels "
         "differing: "
         "against the first row, any float difference";
-    auto cm = std::make_shared<ClusterMesh>(mesh, 0, kLabClusterSize);
+    // The scene refers to the caller's mesh (no ownership: it outlives the scene).
+    std::shared_ptr<LabBvhMesh> cm(&mesh, [](LabBvhMesh*) {});
     Scene scene;
     scene.name = "mesh";
     scene.geometries.push_back(cm);
     Bounds3f b(cm->boundsMin(), cm->boundsMax());
     float diag = glm::length(b.diagonal());
-    scene.lights.push_back({b.centroid() + diag * Vec3(0.6f, 1.2f, 0.9f), Vec3(1.6f * diag * diag),
-                            PointLight::radiusFor(Vec3(1.6f * diag * diag))});
+    scene.lights.push_back(
+        {b.centroid() + diag * Vec3(0.6f, 1.2f, 0.9f), Vec3(1.6f * diag * diag)});
+    scene.setLightRadii();
     scene.camera = fitCamera(b.min, b.max, 4.0f / 3.0f);
     struct Variant {
         const char* name;
-        ClusterMeshOptions opt;
+        LabMeshOptions opt;
     };
     std::vector<Variant> variants = {
-        {"naive: divisions, edges per test, every box, nearest for shadows",
+        {"naive: divisions, edges per test, every node, nearest for shadows",
          {false, false, false, false}},
         {"+ reciprocal direction and signs per ray", {true, false, false, false}},
         {"+ precomputed triangle edges", {true, true, false, false}},
-        {"+ early out (skip far boxes, any-hit shadows)", {true, true, true, true}}};
+        {"+ early out (skip far nodes, any-hit shadows)", {true, true, true, true}}};
     Renderer r(scene, scene.camera, oneThread(sized(o, 96), sized(o, 72)));
     const double px = double(sized(o, 96) * sized(o, 72));
     std::vector<Image> images;
@@ -562,6 +578,7 @@ Table measurePrecalculation(const Mesh& mesh, const LabOptions& o) {
             keepValue(r.render());
         });
     std::vector<Timing> times = measureInterleaved(o.repeats, frames);
+    cm->setOptions({});
     for (size_t i = 0; i < variants.size(); ++i) {
         size_t differ = compareImages(images[i], images[0]).pixelsDiffering;
         t.row({std::string(variants[i].name), ms(times[i].median), ms(times[i].min),

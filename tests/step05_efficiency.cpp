@@ -523,7 +523,7 @@ TEST_SUITE("renderer 05") {
         Image ref;
         uint64_t tests[2] = {0, 0};
         for (int v = 0; v < 16; ++v) {
-            LabMeshOptions o{bool(v & 1), bool(v & 2), bool(v & 4), bool(v & 8)};
+            LabMeshOptions o{bool(v & 1), bool(v & 2), bool(v & 4), bool(v & 8), false};
             cm->setOptions(o);
             cm->resetCounters();
             Image img = renderImage(scene, scene.camera, s);
@@ -557,6 +557,7 @@ TEST_SUITE("renderer 05") {
                 }
                 for (int skip = 0; skip < 2; ++skip) {
                     LabMeshOptions o;
+                    o.robust = false;  // the same Moller-Trumbore as the brute force
                     o.skipBeyondNearest = skip == 1;
                     cm.setOptions(o);
                     cm.resetCounters();
@@ -579,6 +580,18 @@ TEST_SUITE("renderer 05") {
                     }
                     CHECK(blocked[0] == blocked[1]);
                 }
+            }
+        // With every switch on (robust: step 04's watertight and conservative tests, not its
+        // exercises), the hits equal step 04's watertight brute force.
+        cm.setOptions({});
+        for (int y = 0; y < 24; ++y)
+            for (int x = 0; x < 24; ++x) {
+                Ray ray(cam.eye, cam.directionThrough(basis, x + 0.5f, y + 0.5f, 24, 24));
+                TraceHit reference = traceBruteForce(mesh, ray);
+                SurfaceHit hit;
+                bool found = cm.intersect(ray, hit);
+                REQUIRE(found == (reference.triangle != kNoPrimitive));
+                if (found) CHECK(hit.t == reference.t);
             }
         CHECK(hits > 100);
         CHECK(primary[1] < primary[0]);  // skipping nodes beyond the nearest t tests less

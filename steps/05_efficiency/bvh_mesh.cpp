@@ -24,22 +24,37 @@ LabBvhMesh::LabBvhMesh(const Mesh& mesh, int material)
     }
 }
 
-bool LabBvhMesh::boxTest(const Ray& ray, PrecomputedRay& pre, const BvhNode& node, float tmax,
-                         float& tEntry) const {
+LabBvhMesh::RayData LabBvhMesh::prepare(const Ray& ray) const {
+    // Only what the chosen tests use is computed (the others are left default).
+    const bool robust = options_.robust;
+    return {ray, !robust && options_.reciprocal ? precomputeRay(ray) : PrecomputedRay{},
+            robust ? TraversalRay(ray, bvh_) : TraversalRay(Ray(Vec3(0.0f), Vec3(1.0f))),
+            robust ? WatertightRay(ray) : WatertightRay(Ray(Vec3(0.0f), Vec3(1.0f)))};
+}
+
+bool LabBvhMesh::boxTest(RayData& r, const BvhNode& node, float tmax, float& tEntry) const {
+    if (options_.robust) return intersectNodeBounds(node, r.traversal, tmax, tEntry);
     std::optional<float> t;
     if (options_.reciprocal) {
-        pre.tmax = tmax;
-        t = slabReciprocal(pre, node.bounds());
+        r.pre.tmax = tmax;
+        t = slabReciprocal(r.pre, node.bounds());
     } else {
-        Ray r = ray;
-        r.tmax = tmax;
-        t = slabDivision(r, node.bounds());
+        Ray clipped = r.ray;
+        clipped.tmax = tmax;
+        t = slabDivision(clipped, node.bounds());
     }
     if (t) tEntry = *t;
     return t.has_value();
 }
 
-std::optional<TriangleHitT> LabBvhMesh::triangleTest(const Ray& ray, uint32_t slot) const {
+std::optional<TriangleHitT> LabBvhMesh::triangleTest(const RayData& r, const Ray& ray,
+                                                     uint32_t slot) const {
+    if (options_.robust) {
+        float t = ray.tmax, u = 0.0f, v = 0.0f;
+        if (!intersectLeafTriangle(r.watertight, bvh_.leafTriangles[slot], t, &u, &v))
+            return std::nullopt;
+        return TriangleHitT{t, u, v};
+    }
     return options_.precomputedTriangles ? intersectPrecomputed(ray, precomputed_[slot])
                                          : intersectFromVertices(ray, vertices_[slot]);
 }
@@ -47,7 +62,7 @@ std::optional<TriangleHitT> LabBvhMesh::triangleTest(const Ray& ray, uint32_t sl
 long LabBvhMesh::nearest(const Ray& rayIn, TriangleHitT& best) const {
     if (bvh_.empty()) return -1;
     Ray ray = rayIn;  // ray.tmax falls to the nearest hit found so far
-    PrecomputedRay pre = options_.reciprocal ? precomputeRay(ray) : PrecomputedRay{};
+    RayData data = prepare(rayIn);
     uint64_t boxes = 0, tris = 0;
     long found = -1;
     const bool skip = options_.skipBeyondNearest;
@@ -58,7 +73,7 @@ long LabBvhMesh::nearest(const Ray& rayIn, TriangleHitT& best) const {
     int size = 0;
     float tRoot = 0.0f;
     ++boxes;
-    if (boxTest(rayIn, pre, bvh_.nodes[0], rayIn.tmax, tRoot)) stack[size++] = {0, tRoot};
+    if (boxTest(data, bvh_.nodes[0], rayIn.tmax, tRoot)) stack[size++] = {0, tRoot};
     while (size > 0) {
         Entry e = stack[--size];
         // Early out: a node entered beyond the nearest hit so far cannot hold a nearer one.
@@ -67,7 +82,7 @@ long LabBvhMesh::nearest(const Ray& rayIn, TriangleHitT& best) const {
         if (node.isLeaf()) {
             for (uint32_t s = node.leftFirst; s < node.leftFirst + node.count; ++s) {
                 ++tris;
-                if (auto h = triangleTest(ray, s)) {
+                if (auto h = triangleTest(data, ray, s)) {
                     best = *h;
                     ray.tmax = h->t;
                     found = long(s);
@@ -82,8 +97,8 @@ long LabBvhMesh::nearest(const Ray& rayIn, TriangleHitT& best) const {
         uint32_t a = node.leftFirst, b = node.leftFirst + 1;
         float ta = 0.0f, tb = 0.0f;
         boxes += 2;
-        bool hitA = boxTest(rayIn, pre, bvh_.nodes[a], boxTmax, ta);
-        bool hitB = boxTest(rayIn, pre, bvh_.nodes[b], boxTmax, tb);
+        bool hitA = boxTest(data, bvh_.nodes[a], boxTmax, ta);
+        bool hitB = boxTest(data, bvh_.nodes[b], boxTmax, tb);
         if (skip && hitA && hitB && tb < ta) {
             std::swap(a, b);
             std::swap(ta, tb);
@@ -129,7 +144,7 @@ bool LabBvhMesh::occluded(const Ray& ray) const {
     }
     if (bvh_.empty()) return false;
     // Any hit: no order, no nearest t; the first triangle that blocks ends the traversal.
-    PrecomputedRay pre = options_.reciprocal ? precomputeRay(ray) : PrecomputedRay{};
+    RayData data = prepare(ray);
     uint64_t boxes = 0, tris = 0;
     uint32_t stack[kTraversalStackSize];
     int size = 0;
@@ -139,12 +154,12 @@ bool LabBvhMesh::occluded(const Ray& ray) const {
         const BvhNode& node = bvh_.nodes[stack[--size]];
         float tEntry;
         ++boxes;
-        if (!boxTest(ray, pre, node, ray.tmax, tEntry)) continue;
+        if (!boxTest(data, node, ray.tmax, tEntry)) continue;
         if (node.isLeaf()) {
             blocked = anyHit(  // exercise 5.4 over the leaf's triangles
                 node.count,
                 [&](size_t j) {
-                    return triangleTest(ray, node.leftFirst + uint32_t(j)).has_value();
+                    return triangleTest(data, ray, node.leftFirst + uint32_t(j)).has_value();
                 },
                 tris);
         } else {

@@ -12,6 +12,7 @@
 #include <vector>
 
 #include "04_bvh/bvh.hpp"
+#include "04_bvh/trace.hpp"
 #include "05_efficiency/lab.hpp"
 #include "core/scene.hpp"
 
@@ -22,6 +23,11 @@ struct LabMeshOptions {
     bool precomputedTriangles = true;  // edges stored with the triangle (5.7)
     bool skipBeyondNearest = true;     // nearest hit: nearer child first, skip nodes beyond t
     bool anyHitShadows = true;         // shadow rays stop at the first occluder (5.4)
+    // Step 04's watertight triangle test and conservative box test (not its exercises)
+    // instead of the two above: Moller-Trumbore lets a ray through the edge two triangles
+    // share miss both (a dark speck of floor through the bunny); renders use this, the
+    // precalc table switches it off to time 5.6 and 5.7.
+    bool robust = true;
 };
 
 class LabBvhMesh : public Geometry {
@@ -50,9 +56,16 @@ public:
 private:
     // Nearest triangle (leaf slot) in [ray.tmin, ray.tmax], or -1.
     long nearest(const Ray& ray, TriangleHitT& best) const;
-    bool boxTest(const Ray& ray, PrecomputedRay& pre, const BvhNode& node, float tmax,
-                 float& tEntry) const;
-    std::optional<TriangleHitT> triangleTest(const Ray& ray, uint32_t slot) const;
+    // What a traversal prepares once per ray for the tests below.
+    struct RayData {
+        const Ray& ray;
+        PrecomputedRay pre;
+        TraversalRay traversal;
+        WatertightRay watertight;
+    };
+    RayData prepare(const Ray& ray) const;
+    bool boxTest(RayData& r, const BvhNode& node, float tmax, float& tEntry) const;
+    std::optional<TriangleHitT> triangleTest(const RayData& r, const Ray& ray, uint32_t slot) const;
 
     const Mesh& mesh_;
     int material_;

@@ -111,8 +111,9 @@ Camera fitCamera(Vec3 lo, Vec3 hi, float aspect, Vec3 from, Vec3 up, float fovYD
 
 namespace {
 
+// The radius is set by Scene::setLightRadii once the scene has all its lights.
 PointLight lightAt(Vec3 position, Vec3 intensity) {
-    return {position, intensity, PointLight::radiusFor(intensity)};
+    return {position, intensity, kInfinity<float>};
 }
 
 Scene classicSpheres() {
@@ -169,19 +170,29 @@ Scene singleSphere() {
     return s;
 }
 
-// Many small lights over a floor: most lights are beyond reach of most points.
+// A street of 20 weak lamps (two rows of 10 along -z, 30 apart) over diffuse spheres. With
+// 1 / d^2 falloff a light's radius (below half an 8-bit sRGB step shared by 20 lights) is
+// about 36 times the distance where it falls to 0.01; only lights far apart put most of
+// them beyond it for most points.
 Scene smallLights() {
     Scene s = diffuseOnly();
     s.name = "small-lights";
     s.lights.clear();
-    s.ambient = Vec3(0.02f);
-    for (int i = 0; i < 5; ++i)
-        for (int j = 0; j < 4; ++j) {
-            Vec3 colour(0.6f + 0.1f * float(i % 3), 0.7f, 0.6f + 0.1f * float(j % 3));
-            Vec3 intensity = 0.12f * colour;
-            s.lights.push_back(
-                lightAt(Vec3(-4.0f + 2.0f * float(i), 0.9f, -3.5f + 2.0f * float(j)), intensity));
+    s.spheres.clear();
+    s.ambient = Vec3(0.005f);
+    s.background = Vec3(0.01f, 0.012f, 0.02f);  // night
+    for (int i = 0; i < 10; ++i) {
+        float z = 1.0f - 30.0f * float(i);
+        for (int side = 0; side < 2; ++side) {
+            Vec3 colour(0.6f + 0.1f * float(i % 3), 0.7f, 0.6f + 0.1f * float((i + side) % 3));
+            s.lights.push_back(lightAt(Vec3(side ? 3.0f : -3.0f, 1.0f, z), 0.2f * colour));
         }
+        // A sphere by every lamp post, on alternate sides.
+        s.spheres.push_back({{Vec3(i % 2 ? 1.8f : -1.8f, 0.6f, z - 1.5f), 0.6f}, 1 + i % 4});
+    }
+    s.camera.eye = Vec3(0.0f, 3.0f, 8.0f);
+    s.camera.view = Vec3(0.0f, -0.36f, -1.0f);
+    s.camera.fovYDegrees = 45.0f;
     return s;
 }
 
@@ -211,13 +222,20 @@ Scene meshScene(const std::string& name, const std::string& path, float aspect, 
 
 }  // namespace
 
+void Scene::setLightRadii() {
+    const float threshold = PointLight::cutoffThreshold(lights.size());
+    for (PointLight& light : lights)
+        light.radius = PointLight::radiusFor(light.intensity, threshold);
+}
+
 std::vector<std::pair<std::string, std::string>> builtinScenes() {
     return {{"spheres", "spheres on a floor: diffuse, a mirror and glass, two lights"},
             {"diffuse", "the same spheres, all diffuse (no reflection or refraction rays)"},
             {"mirrors", "the same spheres with two mirrors and no glass"},
             {"glass", "the same spheres with two glass balls and no mirror"},
             {"single-sphere", "one diffuse sphere and one light (nothing can cast a shadow)"},
-            {"small-lights", "diffuse spheres under 20 weak lights of small radius"},
+            {"small-lights",
+             "a street of 20 weak lamps over diffuse spheres (the far ones out of range)"},
             {"bunny", "the Stanford bunny (data/meshes/bunny.obj) on a floor"},
             {"sh1", "a closed CAD shape (data/meshes/sh1.obj)"}};
 }
@@ -250,6 +268,7 @@ Scene makeScene(const std::string& nameOrPath, const SceneOptions& options) {
                          "; or a path ending in .obj)");
     }
     s.camera.aspect = options.aspect;
+    s.setLightRadii();
     return s;
 }
 

@@ -16,7 +16,7 @@ namespace boxes {
 struct Material {
     enum class Kind { Diffuse, Mirror, Glass };
     Kind kind = Kind::Diffuse;
-    Vec3 albedo{0.75f};      // diffuse colour; the tint of a mirror
+    Vec3 albedo{0.75f};        // diffuse colour; the tint of a mirror
     float reflectance = 0.0f;  // mirror: share of light reflected
     float ior = 1.5f;          // glass: index of refraction
 
@@ -34,9 +34,25 @@ struct PointLight {
     Vec3 intensity{1.0f};
     float radius = kInfinity<float>;
 
-    // Distance at which the largest channel of intensity / d^2 falls to `threshold`
-    // (default: half of one 8-bit step of an albedo-1 surface lit head-on).
-    static float radiusFor(Vec3 intensity, float threshold = 0.5f / 255.0f) {
+    // Half of one 8-bit step of the sRGB-encoded image, in linear light. The sRGB curve is
+    // steepest at black, where it is linear with slope 12.92 (beyond 0.0031308 its slope is
+    // smaller), so a linear change below this moves the encoded value by less than half a
+    // step anywhere on the curve. (Half a step in linear light, 0.5 / 255, is 12.92 times
+    // too coarse near black: it moved the PNG of 'small-lights' by 2 steps.)
+    static constexpr float kHalfStep8 = 0.5f / 255.0f / 12.92f;
+
+    // The threshold per light when the cut-offs of `lightCount` lights may add up at one
+    // point: each skipped contribution is below kHalfStep8 / lightCount, so together they
+    // are below half a step, and the 8-bit image differs from the render without radii by
+    // at most one step. This assumes a pixel is a weighted sum of direct light with weights
+    // summing to at most 1 (albedo, mirror reflectance and Fresnel weights at most 1).
+    static float cutoffThreshold(size_t lightCount) {
+        return kHalfStep8 / float(lightCount > 0 ? lightCount : 1);
+    }
+
+    // Distance at which the largest channel of intensity / d^2 falls to `threshold` (an
+    // albedo-1 surface lit head-on receives at most intensity / d^2).
+    static float radiusFor(Vec3 intensity, float threshold = kHalfStep8) {
         return std::sqrt(maxComponent(intensity) / threshold);
     }
 };
@@ -92,6 +108,9 @@ struct Scene {
     // A scene with a mesh but no geometry for it cannot be rendered (logic_error); NaN or
     // infinite spheres, planes, lights or mesh vertices are refused (InputError).
     void checkRenderable() const;
+    // Every light's radius for PointLight::cutoffThreshold(lights.size()): the image is then
+    // within one 8-bit step of the render with infinite radii.
+    void setLightRadii();
 };
 
 // Fits the camera to look at the box [lo, hi] from the direction `from`, the whole box

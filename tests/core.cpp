@@ -121,9 +121,21 @@ TEST_SUITE("core") {
         CHECK(s.occluded(Ray(Vec3(0), Vec3(0, 0, -1), 0.0f, 2.6f)));
         CHECK_FALSE(s.occluded(Ray(Vec3(0), Vec3(0, 0, -1), 0.0f, 2.4f)));
     }
-    TEST_CASE("light radius: where intensity / d^2 falls to half an 8-bit step") {
-        // I = 2: d = sqrt(2 / (0.5/255)) = sqrt(1020).
-        CHECK(PointLight::radiusFor(Vec3(2.0f, 1.0f, 0.5f)) == doctest::Approx(std::sqrt(1020.0f)));
+    TEST_CASE("light radius: where intensity / d^2 falls to half an 8-bit sRGB step") {
+        // Half a step of the encoded image is 0.5 / 255 / 12.92 in linear light (sRGB's slope
+        // at black). I = 2: d = sqrt(2 * 255 * 2 * 12.92) = sqrt(13178.4).
+        CHECK(PointLight::radiusFor(Vec3(2.0f, 1.0f, 0.5f)) == doctest::Approx(std::sqrt(13178.4)));
+        // Shared by 4 lights: each gets a quarter, the radius doubles.
+        CHECK(PointLight::cutoffThreshold(4) == doctest::Approx(0.5 / 255.0 / 12.92 / 4.0));
+        CHECK(PointLight::radiusFor(Vec3(2.0f), PointLight::cutoffThreshold(4)) ==
+              doctest::Approx(2.0 * std::sqrt(13178.4)));
+        // A linear change below the threshold moves the 8-bit sRGB value by at most one step.
+        for (float v : {0.0f, 1e-4f, 0.0031f, 0.01f, 0.2f, 0.99f})
+            CHECK(int(encodeSrgb8(v + PointLight::kHalfStep8)) - int(encodeSrgb8(v)) <= 1);
+        Scene scene = makeScene("spheres", {});
+        for (const PointLight& l : scene.lights)
+            CHECK(l.radius == doctest::Approx(PointLight::radiusFor(
+                                  l.intensity, PointLight::cutoffThreshold(scene.lights.size()))));
     }
 }
 

@@ -4,7 +4,7 @@
 #include <cstring>
 #include <random>
 
-#include "05_efficiency/cluster_mesh.hpp"
+#include "05_efficiency/bvh_mesh.hpp"
 #include "05_efficiency/lab.hpp"
 #include "05_efficiency/measure.hpp"
 #include "05_efficiency/progressive.hpp"
@@ -26,6 +26,14 @@ std::vector<float> referenceTable(int n) {
 bool bitIdentical(const Image& a, const Image& b) {
     return a.width() == b.width() && a.height() == b.height() &&
            std::memcmp(a.pixels().data(), b.pixels().data(), a.pixels().size() * sizeof(Vec3)) == 0;
+}
+
+// The largest difference of two images in steps of their 8-bit sRGB encoding (the PNG).
+int maxStep8(const Image& a, const Image& b) {
+    auto x = a.toRgb8(), y = b.toRgb8();
+    int worst = 0;
+    for (size_t i = 0; i < x.size(); ++i) worst = std::max(worst, std::abs(int(x[i]) - int(y[i])));
+    return worst;
 }
 
 double maxErrorOverCircle(const std::function<float(float)>& f, int samples = 200000) {
@@ -155,12 +163,16 @@ TEST_SUITE("exercise 5.4") {
 
 TEST_SUITE("exercise 5.5") {
     TEST_CASE("finite light radius: intensity / r^2 equals the threshold") {
-        // 40 / r^2 = 0.5 / 255  =>  r = sqrt(20400) = 142.828...
-        CHECK(finiteLightRadius(Vec3(40.0f)) == doctest::Approx(std::sqrt(20400.0)).epsilon(1e-6));
+        // The default threshold is half an 8-bit step of the sRGB image in linear light,
+        // 0.5 / 255 / 12.92: 40 / r^2 = 0.5 / (255 * 12.92)  =>  r = sqrt(263568) = 513.39...
+        CHECK(finiteLightRadius(Vec3(40.0f)) == doctest::Approx(std::sqrt(263568.0)).epsilon(1e-6));
         // The largest channel decides.
         CHECK(finiteLightRadius(Vec3(1.0f, 4.0f, 2.0f), 1.0f) == doctest::Approx(2.0f));
         float r = finiteLightRadius(Vec3(12.0f, 11.0f, 9.0f));
-        CHECK(12.0 / (double(r) * r) == doctest::Approx(0.5 / 255.0).epsilon(1e-6));
+        CHECK(12.0 / (double(r) * r) == doctest::Approx(0.5 / 255.0 / 12.92).epsilon(1e-6));
+        // The old linear half step gives sqrt(40 * 510) = sqrt(20400).
+        CHECK(finiteLightRadius(Vec3(40.0f), 0.5f / 255.0f) ==
+              doctest::Approx(std::sqrt(20400.0)).epsilon(1e-6));
         CHECK(finiteLightRadius(Vec3(0.0f)) == 0.0f);
     }
     TEST_CASE("hard case: a zero or negative threshold is refused") {
@@ -434,28 +446,71 @@ TEST_SUITE("renderer 05") {
         CHECK(d.reflection == 0);
         CHECK(d.refraction == 0);
     }
-    TEST_CASE("finite light radius: within one 8-bit step of linear light and fewer evaluations") {
-        // 20 weak lights: beyond its radius each skipped light adds less than half a step, and
-        // few points are beyond more than one light's radius at a time.
-        Scene finite = makeScene("small-lights", {});
-        Scene infinite = finite;
-        for (auto& l : infinite.lights) l.radius = kInfinity<float>;
-        RenderSettings s;
-        s.width = 40;
-        s.height = 30;
-        RayCounts cf, ci;
-        Image a = renderImage(finite, finite.camera, s, &cf);
-        Image b = renderImage(infinite, infinite.camera, s, &ci);
-        ImageDifference d = compareImages(a, b);
-        INFO("max linear difference " << d.maxError * 255.0 << " / 255");
-        CHECK(d.maxError <= 1.0 / 255.0);
-        CHECK(cf.lightsOutOfRange > 0);
-        CHECK(ci.lightsOutOfRange == 0);
-        CHECK(cf.shadow < ci.shadow);
+    TEST_CASE("finite light radius: within one 8-bit sRGB step and fewer evaluations") {
+        // Every built-in scene with its default radii (PointLight::cutoffThreshold: half an
+        // sRGB step shared by the lights) against infinite radii: the PNGs differ by at most
+        // one step. On the street of lamps most evaluations and shadow rays are skipped.
+        for (const char* name :
+             {"small-lights", "spheres", "diffuse", "mirrors", "glass", "single-sphere"}) {
+            Scene finite = makeScene(name, {});
+            Scene infinite = finite;
+            for (auto& l : infinite.lights) l.radius = kInfinity<float>;
+            RenderSettings s;
+            s.width = 80;
+            s.height = 60;
+            RayCounts cf, ci;
+            Image a = renderImage(finite, finite.camera, s, &cf);
+            Image b = renderImage(infinite, infinite.camera, s, &ci);
+            INFO(name);
+            CHECK(maxStep8(a, b) <= 1);
+            CHECK(ci.lightsOutOfRange == 0);
+            if (std::string(name) == "small-lights") {
+                CHECK(cf.lightsOutOfRange > 0);
+                CHECK(cf.shadow < ci.shadow);
+            }
+        }
     }
-    TEST_CASE("cluster mesh: every optimization switch gives the same image") {
+    TEST_CASE("hard case: many lights just beyond their radius stay within one step") {
+        // The worst case of the bound: n lights straight above a white floor point, each just
+        // beyond its radius, so each skipped light gives almost its threshold, and the point
+        // is near black, where sRGB is steepest. With the radius shared by n lights the PNG
+        // moves by at most one step; with the old rule (half a step in linear light per
+        // light) the skipped light adds up to many steps.
+        const int n = 8;
+        const Vec3 intensity(0.05f);
+        auto render = [&](float threshold, bool cut, RayCounts* counts) {
+            Scene scene;
+            scene.materials = {Material::diffuse(Vec3(1.0f))};
+            scene.planes.push_back({{Vec3(0, 1, 0), 0.0f}, 0});
+            scene.ambient = Vec3(0.0f);
+            float r = PointLight::radiusFor(intensity, threshold);
+            for (int i = 0; i < n; ++i)
+                scene.lights.push_back(
+                    {Vec3(0.0f, 1.001f * r, 0.0f), intensity, cut ? r : kInfinity<float>});
+            scene.camera.eye = Vec3(0.0f, 1.0f, 0.0f);
+            scene.camera.view = Vec3(0.0f, -1.0f, 0.0f);
+            scene.camera.up = Vec3(0, 0, -1);
+            scene.camera.fovYDegrees = 10.0f;
+            RenderSettings s;
+            s.width = s.height = 8;
+            return renderImage(scene, scene.camera, s, counts);
+        };
+        RayCounts c;
+        float shared = PointLight::cutoffThreshold(n);
+        Image cutShared = render(shared, true, &c);
+        CHECK(c.lightsOutOfRange == uint64_t(8 * 8 * n));  // every light skipped everywhere
+        Image fullShared = render(shared, false, nullptr);
+        CHECK(fullShared.at(4, 4).x > 0.0f);
+        CHECK(maxStep8(cutShared, fullShared) <= 1);
+        float linear = 0.5f / 255.0f;
+        Image cutLinear = render(linear, true, nullptr);
+        Image fullLinear = render(linear, false, nullptr);
+        CHECK(maxStep8(cutLinear, fullLinear) > 10);  // 8 * 0.5/255 linear: about 21 sRGB steps
+    }
+    TEST_CASE("bvh mesh: every optimization switch gives the same image") {
+        // Step 04's tree (its sweep SAH builder, not an exercise) with the lab's traversal.
         Mesh mesh = loadObj(test::dataDir() + "/meshes/sh1.obj");
-        auto cm = std::make_shared<ClusterMesh>(mesh, 0);
+        auto cm = std::make_shared<LabBvhMesh>(mesh, 0);
         Scene scene;
         scene.geometries.push_back(cm);
         Bounds3f b(cm->boundsMin(), cm->boundsMax());
@@ -468,7 +523,7 @@ TEST_SUITE("renderer 05") {
         Image ref;
         uint64_t tests[2] = {0, 0};
         for (int v = 0; v < 16; ++v) {
-            ClusterMeshOptions o{bool(v & 1), bool(v & 2), bool(v & 4), bool(v & 8)};
+            LabMeshOptions o{bool(v & 1), bool(v & 2), bool(v & 4), bool(v & 8), false};
             cm->setOptions(o);
             cm->resetCounters();
             Image img = renderImage(scene, scene.camera, s);
@@ -476,11 +531,71 @@ TEST_SUITE("renderer 05") {
             if (v == 0) tests[0] = cm->triangleTests();
             if (v == 15) tests[1] = cm->triangleTests();
             INFO("variant " << v);
-            // Division and reciprocal slab tests may differ in the last bit of a box entry,
-            // but boxes are tested conservatively against the ray, so hits are unchanged.
+            // Division and reciprocal slab tests may differ in the last bit of a box entry;
+            // no pixel of this view depends on it.
             CHECK(compareImages(img, ref).pixelsDiffering == 0);
         }
         CHECK(tests[1] < tests[0]);
+    }
+    TEST_CASE("bvh mesh: nearest hits equal brute force and the early outs test less") {
+        Mesh mesh = loadObj(test::dataDir() + "/meshes/sh1.obj");
+        LabBvhMesh cm(mesh, 0);
+        Bounds3f b(cm.boundsMin(), cm.boundsMax());
+        Camera cam = fitCamera(b.min, b.max, 1.0f);
+        CameraBasisT<float> basis = cam.basis();
+        Vec3 light = b.centroid() + glm::length(b.diagonal()) * Vec3(0.6f, 1.2f, 0.9f);
+        uint64_t primary[2] = {0, 0}, shadow[2] = {0, 0};
+        int hits = 0;
+        for (int y = 0; y < 24; ++y)
+            for (int x = 0; x < 24; ++x) {
+                Ray ray(cam.eye, cam.directionThrough(basis, x + 0.5f, y + 0.5f, 24, 24));
+                // Brute force over every triangle, the same Moller-Trumbore arithmetic.
+                float nearest = kInfinity<float>;
+                for (size_t t = 0; t < mesh.triangleCount(); ++t) {
+                    TriangleVertices v{mesh.vertex(t, 0), mesh.vertex(t, 1), mesh.vertex(t, 2)};
+                    if (auto h = intersectFromVertices(ray, v)) nearest = std::min(nearest, h->t);
+                }
+                for (int skip = 0; skip < 2; ++skip) {
+                    LabMeshOptions o;
+                    o.robust = false;  // the same Moller-Trumbore as the brute force
+                    o.skipBeyondNearest = skip == 1;
+                    cm.setOptions(o);
+                    cm.resetCounters();
+                    SurfaceHit hit;
+                    bool found = cm.intersect(ray, hit);
+                    primary[skip] += cm.triangleTests();
+                    REQUIRE(found == (nearest < kInfinity<float>));
+                    if (!found) continue;
+                    CHECK(hit.t == nearest);
+                    hits += skip;
+                    Vec3 d = light - hit.point;
+                    Ray shadowRay(offsetOrigin(hit.point, hit.geometricNormal, d), d, 0.0f, 1.0f);
+                    bool blocked[2];
+                    for (int any = 0; any < 2; ++any) {
+                        o.anyHitShadows = any == 1;
+                        cm.setOptions(o);
+                        cm.resetCounters();
+                        blocked[any] = cm.occluded(shadowRay);
+                        if (skip) shadow[any] += cm.triangleTests();
+                    }
+                    CHECK(blocked[0] == blocked[1]);
+                }
+            }
+        // With every switch on (robust: step 04's watertight and conservative tests, not its
+        // exercises), the hits equal step 04's watertight brute force.
+        cm.setOptions({});
+        for (int y = 0; y < 24; ++y)
+            for (int x = 0; x < 24; ++x) {
+                Ray ray(cam.eye, cam.directionThrough(basis, x + 0.5f, y + 0.5f, 24, 24));
+                TraceHit reference = traceBruteForce(mesh, ray);
+                SurfaceHit hit;
+                bool found = cm.intersect(ray, hit);
+                REQUIRE(found == (reference.triangle != kNoPrimitive));
+                if (found) CHECK(hit.t == reference.t);
+            }
+        CHECK(hits > 100);
+        CHECK(primary[1] < primary[0]);  // skipping nodes beyond the nearest t tests less
+        CHECK(shadow[1] <= shadow[0]);   // any hit never tests more than nearest
     }
     TEST_CASE("preview modes render at the requested size and the full mode equals the render") {
         Scene scene = makeScene("spheres", {});

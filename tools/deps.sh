@@ -22,7 +22,7 @@ pkgs_for() {
     ;;
   fuzz) echo clang libclang-rt-dev ;;
   grade) echo bubblewrap python3 ;;
-  bench) echo libbenchmark-dev libembree-dev python3-numpy ;;
+  bench) echo libbenchmark-dev libembree-dev python3-numpy linux-perf ;; # perf: step 05 README
   *)
     echo "tools/deps.sh: unknown group '$1'" >&2
     exit 2

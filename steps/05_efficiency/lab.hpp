@@ -12,6 +12,7 @@
 #include "core/bounds.hpp"
 #include "core/exercise.hpp"
 #include "core/ray.hpp"
+#include "core/scene.hpp"
 
 namespace boxes {
 
@@ -34,7 +35,7 @@ std::vector<float> fillSinTable(int n);
 
 // A table of sines over one full circle; the argument is in radians, any value (wrapped).
 class SinTable {
-  public:
+public:
     explicit SinTable(std::vector<float> entriesPlusOne);
     static SinTable make(int n) { return SinTable(fillSinTable(n)); }
 
@@ -55,7 +56,7 @@ class SinTable {
 
     const std::vector<float>& entries() const { return table_; }
 
-  private:
+private:
     std::vector<float> table_;
     int n_;
     float step_;     // 2 pi / n
@@ -85,8 +86,10 @@ bool anyHit(size_t count, Blocks&& blocks, uint64_t& tests) {
 // ---- Lights with a finite radius --------------------------------------------------------
 
 // Exercise 5.5: the distance beyond which a point light of this intensity (largest
-// channel) falls below `threshold`: intensity / d^2 = threshold.
-float finiteLightRadius(Vec3 intensity, float threshold = 0.5f / 255.0f);
+// channel) falls below `threshold`: intensity / d^2 = threshold. The default is half an
+// 8-bit step of the sRGB-encoded output (PointLight::kHalfStep8, 0.5 / 255 / 12.92 in
+// linear light); with n lights, PointLight::cutoffThreshold(n) shares that half step.
+float finiteLightRadius(Vec3 intensity, float threshold = PointLight::kHalfStep8);
 
 // ---- Precalculation: the ray ---------------------------------------------------------
 

@@ -8,7 +8,7 @@
 #include <iostream>
 #include <memory>
 
-#include "01_triangle/triangle_grid.hpp"
+#include "05_efficiency/bvh_mesh.hpp"
 #include "05_efficiency/measure.hpp"
 #include "05_efficiency/progressive.hpp"
 #include "core/app.hpp"
@@ -122,9 +122,12 @@ int main(int argc, char** argv) {
         parseCommandLine(app, argc, argv);
 
         Scene scene = sceneFromOptions(opts);
-        if (scene.hasMesh())
-            scene.geometries.push_back(
-                std::make_shared<TriangleGrid>(scene.mesh, scene.meshMaterial));
+        // Meshes through step 04's hierarchy (see bvh_mesh.hpp), every optimization on.
+        std::shared_ptr<LabBvhMesh> sceneMesh;
+        if (scene.hasMesh()) {
+            sceneMesh = std::make_shared<LabBvhMesh>(scene.mesh, scene.meshMaterial);
+            scene.geometries.push_back(sceneMesh);
+        }
         Camera camera = cameraFromOptions(opts, scene.camera);
         scene.camera = camera;
         RenderSettings settings;
@@ -185,8 +188,13 @@ int main(int argc, char** argv) {
                 lab.seed = opts.seed;
                 lab.dataDir = opts.dataDir;
                 lab.quick = quick;
-                Mesh bunny =
-                    scene.hasMesh() ? scene.mesh : loadObj(opts.dataDir + "/meshes/bunny.obj");
+                // The mesh tables use the scene's mesh, else the bunny, in step 04's tree.
+                Mesh bunny;
+                std::shared_ptr<LabBvhMesh> labMesh = sceneMesh;
+                if (!labMesh) {
+                    bunny = loadObj(opts.dataDir + "/meshes/bunny.obj");
+                    labMesh = std::make_shared<LabBvhMesh>(bunny, 0);
+                }
                 auto step = [&](const char* what, auto&& f) {
                     std::cerr << "05_efficiency: " << what << "...\n";
                     report.add(f());
@@ -195,10 +203,10 @@ int main(int argc, char** argv) {
                 step("float against double", [&] { return measureFloatDouble(lab); });
                 step("acne", [&] { return measureAcne(lab); });
                 step("sine tables", [&] { return measureSinCos(lab); });
-                step("early out", [&] { return measureEarlyOut(bunny, lab); });
+                step("early out", [&] { return measureEarlyOut(*labMesh, lab); });
                 step("finite light radius", [&] { return measureLightRadius(lab); });
                 step("effects on demand", [&] { return measureEffects(lab); });
-                step("precalculation", [&] { return measurePrecalculation(bunny, lab); });
+                step("precalculation", [&] { return measurePrecalculation(*labMesh, lab); });
                 step("expensive operations", [&] { return measureExpensiveOps(lab); });
                 step("reciprocal square root", [&] { return measureInverseSqrt(lab); });
                 step("threads", [&] { return measureThreads(scene, lab); });

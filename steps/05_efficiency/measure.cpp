@@ -4,10 +4,12 @@
 #include <atomic>
 #include <bit>
 #include <cmath>
+#include <cstring>
+#include <memory>
 #include <random>
 #include <thread>
 
-#include "05_efficiency/cluster_mesh.hpp"
+#include "05_efficiency/bvh_mesh.hpp"
 #include "05_efficiency/lab.hpp"
 #include "05_efficiency/progressive.hpp"
 #include "core/timing.hpp"
@@ -15,10 +17,6 @@
 namespace boxes {
 
 namespace {
-
-// Triangles per box in the lab's flat list of boxes: large enough that triangle tests,
-// not box tests, are most of the work (as they are behind a hierarchy).
-constexpr int kLabClusterSize = 128;
 
 // Image sizes and sample counts, reduced for a quick run.
 int sized(const LabOptions& o, int full) {
@@ -79,7 +77,8 @@ std::optional<T> mtT(const RayT<T>& ray, const Vec3T<T>& a, const Vec3T<T>& b, c
 
 }  // namespace
 
-std::vector<Timing> measureInterleaved(int repeats, const std::vector<std::function<void()>>& fns) {
+std::vector<std::vector<double>> sampleInterleaved(int repeats,
+                                                   const std::vector<std::function<void()>>& fns) {
     std::vector<std::vector<double>> samples(fns.size());
     for (int r = 0; r < repeats; ++r)
         for (size_t i = 0; i < fns.size(); ++i) {
@@ -87,8 +86,12 @@ std::vector<Timing> measureInterleaved(int repeats, const std::vector<std::funct
             fns[i]();
             samples[i].push_back(watch.seconds());
         }
+    return samples;
+}
+
+std::vector<Timing> measureInterleaved(int repeats, const std::vector<std::function<void()>>& fns) {
     std::vector<Timing> out;
-    for (auto& s : samples) out.push_back(summarize(s));
+    for (auto& s : sampleInterleaved(repeats, fns)) out.push_back(summarize(s));
     return out;
 }
 
@@ -343,58 +346,76 @@ Table measureSinCos(const LabOptions& o) {
     return t;
 }
 
-Table measureEarlyOut(const Mesh& mesh, const LabOptions& o) {
+Table measureEarlyOut(LabBvhMesh& mesh, const LabOptions& o) {
     Table t;
     t.id = "early_out";
-    t.title = "Early out: triangle and box tests per ray and time, with and without";
-    t.columns = {"rays",   "method", "count", "box tests/ray", "triangle tests/ray",
-                 "us/ray", "min us", "max us"};
+    t.title = "Early out: box and triangle tests per ray and time, with and without";
+    t.columns = {"rays",   "method", "count",  "box tests/ray", "triangle tests/ray",
+                 "us/ray", "min us", "max us", "speed-up"};
     t.note =
-        "the mesh in 128-triangle clusters behind a flat list of boxes (no hierarchy); primary "
-        "rays "
-        "of an 80x60 view; shadow rays from their hits to the light; one thread, median of repeats";
-    ClusterMesh cm(mesh, 0, kLabClusterSize);
-    Bounds3f b(cm.boundsMin(), cm.boundsMax());
+        "the mesh in step 04's hierarchy (full-sweep SAH, leaves of at most 8 triangles), the "
+        "lab's own traversal; primary rays of an 80x60 view, shadow rays from their hits to the "
+        "light; one thread, median of repeats interleaved round-robin; speed-up: the first row of "
+        "each pair over the second";
+    const Bounds3f b(mesh.boundsMin(), mesh.boundsMax());
     Camera cam = fitCamera(b.min, b.max, 4.0f / 3.0f);
     CameraBasisT<float> basis = cam.basis();
     Vec3 light = b.centroid() + glm::length(b.diagonal()) * Vec3(0.6f, 1.2f, 0.9f);
     std::vector<Ray> primary, shadow;
     const int w = sized(o, 80), h = sized(o, 60);
+    mesh.setOptions({});
     for (int y = 0; y < h; ++y)
         for (int x = 0; x < w; ++x) {
             Ray r(cam.eye, cam.directionThrough(basis, x + 0.5f, y + 0.5f, w, h));
             primary.push_back(r);
             SurfaceHit hit;
-            if (cm.intersect(r, hit)) {
+            if (mesh.intersect(r, hit)) {
                 Vec3 d = light - hit.point;
                 shadow.emplace_back(offsetOrigin(hit.point, hit.geometricNormal, d), d, 0.0f, 1.0f);
             }
         }
-    auto run = [&](const std::string& kind, const std::string& method, const std::vector<Ray>& rays,
-                   ClusterMeshOptions opt, bool shadows) {
-        cm.setOptions(opt);
-        cm.resetCounters();
-        auto pass = [&] {
+    LabMeshOptions on, anyOff, skipOff;
+    anyOff.anyHitShadows = false;
+    skipOff.skipBeyondNearest = false;
+    struct Variant {
+        const char* kind;
+        const char* method;
+        const std::vector<Ray>* rays;
+        LabMeshOptions opt;
+        bool shadows;
+    };
+    const Variant variants[] = {
+        {"shadow", "any hit (stop at the first occluder)", &shadow, on, true},
+        {"shadow", "nearest hit, then 'is there one'", &shadow, anyOff, true},
+        {"primary", "nearer child first, skip nodes beyond the nearest t", &primary, on, false},
+        {"primary", "every node the ray meets, storage order", &primary, skipOff, false}};
+    std::vector<std::function<void()>> passes;
+    std::vector<double> boxes, tris;
+    for (const Variant& v : variants) {
+        auto pass = [&mesh, &v] {
+            mesh.setOptions(v.opt);
             int n = 0;
-            SurfaceHit h;
-            for (const Ray& r : rays) n += shadows ? cm.occluded(r) : cm.intersect(r, h);
+            SurfaceHit hit;
+            for (const Ray& r : *v.rays) n += v.shadows ? mesh.occluded(r) : mesh.intersect(r, hit);
             keepValue(n);
         };
+        mesh.resetCounters();
         pass();
-        double boxes = double(cm.boxTests()) / double(rays.size());
-        double tris = double(cm.triangleTests()) / double(rays.size());
-        Timing tm = measure(o.repeats, pass);
-        double per = 1e6 / double(rays.size());
-        t.row({kind, method, (long long)rays.size(), boxes, tris, tm.median * per, tm.min * per,
-               tm.max * per});
-    };
-    ClusterMeshOptions on, off;
-    off.anyHitShadows = false;
-    run("shadow", "any hit (stop at the first occluder)", shadow, on, true);
-    run("shadow", "nearest hit (boxes front to back)", shadow, off, true);
-    off.skipFarClusters = false;
-    run("primary", "boxes front to back, stop beyond nearest t", primary, on, false);
-    run("primary", "every box the ray meets, storage order", primary, off, false);
+        const double count = double(std::max<size_t>(1, v.rays->size()));
+        boxes.push_back(double(mesh.boxTests()) / count);
+        tris.push_back(double(mesh.triangleTests()) / count);
+        passes.push_back(pass);
+    }
+    std::vector<Timing> times = measureInterleaved(o.repeats, passes);
+    mesh.setOptions({});
+    for (size_t i = 0; i < std::size(variants); ++i) {
+        const Variant& v = variants[i];
+        double per = 1e6 / double(std::max<size_t>(1, v.rays->size()));
+        size_t first = i - i % 2;
+        t.row({std::string(v.kind), std::string(v.method), (long long)v.rays->size(), boxes[i],
+               tris[i], times[i].median * per, times[i].min * per, times[i].max * per,
+               times[first + 1].median / times[i].median});
+    }
     return t;
 }
 
@@ -403,34 +424,64 @@ Table measureLightRadius(const LabOptions& o) {
     t.id = "light_radius";
     t.title = "Lights with a finite radius: time saved and the largest pixel difference";
     t.columns = {"scene",
-                 "radius",
+                 "radius rule",
+                 "largest radius",
                  "ms/frame",
                  "min ms",
                  "max ms",
+                 "speed-up",
                  "light evaluations skipped/pixel",
+                 "shadow rays/pixel",
                  "max diff (8-bit sRGB)",
                  "max diff (linear, 1/255 units)"};
     t.note =
-        "160x120, one thread, median of repeats; radius = sqrt(I_max / (0.5/255)) where I/d^2 "
-        "falls "
-        "below half an 8-bit step (exercise 5.5); against the same scene with infinite radii";
+        "160x120, one thread, median of repeats interleaved round-robin; radius = sqrt(I_max / "
+        "threshold) (exercise 5.5); differences against the same scene with infinite radii, in "
+        "steps of the 8-bit sRGB image (the PNG) and in linear light; 'linear half step': the "
+        "threshold 0.5/255 in linear light, 12.92x too coarse near black; 'sRGB half step': "
+        "0.5/255/12.92 per light (n lights may add up to n half steps); 'sRGB half step / n' (the "
+        "scenes' default, PointLight::cutoffThreshold): guaranteed within one step";
+    struct Rule {
+        const char* name;
+        float threshold;  // 0: infinite radius
+    };
     for (const char* name : {"small-lights", "spheres"}) {
-        Scene finite = makeScene(name, {});
-        Scene infinite = finite;
-        for (auto& l : infinite.lights) l.radius = kInfinity<float>;
+        Scene base = makeScene(name, {});
+        const size_t n = base.lights.size();
+        const Rule rules[] = {{"infinite (reference)", 0.0f},
+                              {"linear half step 0.5/255", 0.5f / 255.0f},
+                              {"sRGB half step per light", PointLight::kHalfStep8},
+                              {"sRGB half step / n (default)", PointLight::cutoffThreshold(n)}};
+        std::vector<Scene> scenes;
+        for (const Rule& rule : rules) {
+            Scene s = base;
+            for (auto& l : s.lights)
+                l.radius = rule.threshold > 0.0f
+                               ? PointLight::radiusFor(l.intensity, rule.threshold)
+                               : kInfinity<float>;
+            scenes.push_back(std::move(s));
+        }
+        const int w = sized(o, 160), h = sized(o, 120);
+        std::vector<std::unique_ptr<Renderer>> renderers;
+        std::vector<std::function<void()>> frames;
+        for (const Scene& s : scenes) {
+            renderers.push_back(std::make_unique<Renderer>(s, s.camera, oneThread(w, h)));
+            frames.push_back([r = renderers.back().get()] { keepValue(r->render()); });
+        }
+        std::vector<Timing> times = measureInterleaved(o.repeats, frames);
         Image ref;
-        for (int pass = 0; pass < 2; ++pass) {
-            const Scene& s = pass == 0 ? infinite : finite;
-            const int w = sized(o, 160), h = sized(o, 120);
-            Renderer r(s, s.camera, oneThread(w, h));
+        for (size_t i = 0; i < scenes.size(); ++i) {
             RayCounts c;
-            Image img = r.render(&c);
-            Timing tm = measure(o.repeats, [&] { keepValue(r.render()); });
-            if (pass == 0) ref = img;
+            Image img = renderers[i]->render(&c);
+            if (i == 0) ref = img;
+            float largest = 0.0f;
+            for (const auto& l : scenes[i].lights) largest = std::max(largest, l.radius);
             ImageDifference d = compareImages(img, ref);
-            t.row({std::string(name), std::string(pass == 0 ? "infinite" : "finite"), ms(tm.median),
-                   ms(tm.min), ms(tm.max), double(c.lightsOutOfRange) / double(w * h),
-                   maxStep8(img, ref), d.maxError * 255.0});
+            const double px = double(w * h);
+            t.row({std::string(name), std::string(rules[i].name), double(largest),
+                   ms(times[i].median), ms(times[i].min), ms(times[i].max),
+                   times[0].median / times[i].median, double(c.lightsOutOfRange) / px,
+                   double(c.shadow) / px, maxStep8(img, ref), d.maxError * 255.0});
         }
     }
     return t;
@@ -467,7 +518,7 @@ Table measureEffects(const LabOptions& o) {
     return t;
 }
 
-Table measurePrecalculation(const Mesh& mesh, const LabOptions& o) {
+Table measurePrecalculation(LabBvhMesh& mesh, const LabOptions& o) {
     Table t;
     t.id = "precalc";
     t.title =
@@ -481,30 +532,33 @@ Table measurePrecalculation(const Mesh& mesh, const LabOptions& o) {
                  "triangle tests/pixel",
                  "pixels differing"};
     t.note =
-        "the mesh alone (no floor) in 128-triangle clusters behind a flat "
-        "list of boxes, 96x72, primary and shadow rays, one thread, median of repeats interleaved "
+        "the mesh alone (no floor) in step 04's hierarchy, the lab's traversal with each switch "
+        "(Moller-Trumbore and the lab's slab tests, not step 04's robust ones), "
+        "96x72, primary and shadow rays, one thread, median of repeats interleaved "
         "(one frame of each variant per round); pixels "
         "differing: "
         "against the first row, any float difference";
-    auto cm = std::make_shared<ClusterMesh>(mesh, 0, kLabClusterSize);
+    // The scene refers to the caller's mesh (no ownership: it outlives the scene).
+    std::shared_ptr<LabBvhMesh> cm(&mesh, [](LabBvhMesh*) {});
     Scene scene;
     scene.name = "mesh";
     scene.geometries.push_back(cm);
     Bounds3f b(cm->boundsMin(), cm->boundsMax());
     float diag = glm::length(b.diagonal());
-    scene.lights.push_back({b.centroid() + diag * Vec3(0.6f, 1.2f, 0.9f), Vec3(1.6f * diag * diag),
-                            PointLight::radiusFor(Vec3(1.6f * diag * diag))});
+    scene.lights.push_back(
+        {b.centroid() + diag * Vec3(0.6f, 1.2f, 0.9f), Vec3(1.6f * diag * diag)});
+    scene.setLightRadii();
     scene.camera = fitCamera(b.min, b.max, 4.0f / 3.0f);
     struct Variant {
         const char* name;
-        ClusterMeshOptions opt;
+        LabMeshOptions opt;
     };
     std::vector<Variant> variants = {
-        {"naive: divisions, edges per test, every box, nearest for shadows",
-         {false, false, false, false}},
-        {"+ reciprocal direction and signs per ray", {true, false, false, false}},
-        {"+ precomputed triangle edges", {true, true, false, false}},
-        {"+ early out (skip far boxes, any-hit shadows)", {true, true, true, true}}};
+        {"naive: divisions, edges per test, every node, nearest for shadows",
+         {false, false, false, false, false}},
+        {"+ reciprocal direction and signs per ray", {true, false, false, false, false}},
+        {"+ precomputed triangle edges", {true, true, false, false, false}},
+        {"+ early out (skip far nodes, any-hit shadows)", {true, true, true, true, false}}};
     Renderer r(scene, scene.camera, oneThread(sized(o, 96), sized(o, 72)));
     const double px = double(sized(o, 96) * sized(o, 72));
     std::vector<Image> images;
@@ -525,6 +579,7 @@ Table measurePrecalculation(const Mesh& mesh, const LabOptions& o) {
             keepValue(r.render());
         });
     std::vector<Timing> times = measureInterleaved(o.repeats, frames);
+    cm->setOptions({});
     for (size_t i = 0; i < variants.size(); ++i) {
         size_t differ = compareImages(images[i], images[0]).pixelsDiffering;
         t.row({std::string(variants[i].name), ms(times[i].median), ms(times[i].min),
@@ -789,25 +844,44 @@ Table measureThreads(const Scene& scene, const LabOptions& o) {
     Table t;
     t.id = "threads";
     t.title = "Threads: speed-up over one thread, and how the work is handed out";
-    t.columns = {"threads", "schedule", "ms/frame", "min ms", "max ms", "speed-up", "identical"};
+    t.columns = {"threads",  "schedule",     "ms/frame",     "min ms",   "max ms",
+                 "speed-up", "speed-up min", "speed-up max", "identical"};
     int all = int(std::max(1u, std::thread::hardware_concurrency()));
-    t.note = "scene '" + scene.name +
-             "', 320x240, median of repeats; speed-up against one thread with the "
-             "same schedule; this machine has " +
-             std::to_string(all) + " hardware threads (shared)";
+    const int repeats = std::max(o.repeats, 7);
+    t.note = "scene '" + scene.name + "', " + std::to_string(sized(o, 320)) + "x" +
+             std::to_string(sized(o, 240)) + ", " + std::to_string(repeats) +
+             " rounds; each round renders one frame of every row in turn (round-robin), and the "
+             "speed-up is per round (one thread's frame over this row's frame in the same round), "
+             "then its median, min and max: a change of the machine's load hits both frames of a "
+             "ratio alike; this machine has " +
+             std::to_string(all) + " hardware threads" + (all <= 2 ? " (so 'all' is 2)" : "") +
+             ", shared with other work";
     Renderer r(scene, scene.camera, oneThread(sized(o, 320), sized(o, 240)));
     Image ref = r.render();
     std::vector<int> counts = {1, 2};
     if (all > 2) counts.push_back(all);
-    for (Schedule s : {Schedule::StaticRows, Schedule::DynamicRows, Schedule::DynamicTiles}) {
-        double one = 0.0;
-        for (int n : counts) {
-            Image img;
-            Timing tm = measure(o.repeats, [&] { img = renderScheduled(r, n, s); });
-            if (n == 1) one = tm.median;
-            t.row({(long long)n, std::string(scheduleName(s)), ms(tm.median), ms(tm.min),
-                   ms(tm.max), one / tm.median, std::string(identical(img, ref) ? "yes" : "NO")});
-        }
+    struct Variant {
+        Schedule schedule;
+        int threads;
+        Image image;
+    };
+    std::vector<Variant> variants;
+    for (Schedule s : {Schedule::StaticRows, Schedule::DynamicRows, Schedule::DynamicTiles})
+        for (int n : counts) variants.push_back({s, n, Image()});
+    std::vector<std::function<void()>> frames;
+    for (Variant& v : variants)
+        frames.push_back([&r, &v] { v.image = renderScheduled(r, v.threads, v.schedule); });
+    std::vector<std::vector<double>> samples = sampleInterleaved(repeats, frames);
+    for (size_t i = 0; i < variants.size(); ++i) {
+        // The one-thread row of the same schedule comes first in its group.
+        size_t one = i - i % counts.size();
+        std::vector<double> ratios;
+        for (int k = 0; k < repeats; ++k)
+            ratios.push_back(samples[one][size_t(k)] / samples[i][size_t(k)]);
+        Timing tm = summarize(samples[i]), speedup = summarize(ratios);
+        t.row({(long long)variants[i].threads, std::string(scheduleName(variants[i].schedule)),
+               ms(tm.median), ms(tm.min), ms(tm.max), speedup.median, speedup.min, speedup.max,
+               std::string(identical(variants[i].image, ref) ? "yes" : "NO")});
     }
     return t;
 }

@@ -12,6 +12,8 @@
 
 namespace boxes {
 
+class LabBvhMesh;
+
 struct LabOptions {
     int repeats = 5;  // timed repeats per variant (medians of these)
     int threads = 0;  // for the threads table only: every other table is one thread
@@ -24,10 +26,10 @@ Table measureMeasuring(const LabOptions& o);    // one call per sample against b
 Table measureFloatDouble(const LabOptions& o);  // ray/triangle and ray/sphere, far scenes
 Table measureAcne(const LabOptions& o);         // shadow ray self-intersection in pixels
 Table measureSinCos(const LabOptions& o);       // std::sin against tables and a polynomial
-Table measureEarlyOut(const Mesh& mesh, const LabOptions& o);
+Table measureEarlyOut(LabBvhMesh& mesh, const LabOptions& o);  // step 04's tree
 Table measureLightRadius(const LabOptions& o);
 Table measureEffects(const LabOptions& o);  // effects on demand: analysis on / forced
-Table measurePrecalculation(const Mesh& mesh, const LabOptions& o);
+Table measurePrecalculation(LabBvhMesh& mesh, const LabOptions& o);
 Table measureExpensiveOps(const LabOptions& o);  // sqrt and division per ray
 Table measureInverseSqrt(const LabOptions& o);
 Table measureThreads(const Scene& scene, const LabOptions& o);
@@ -37,6 +39,9 @@ Table measurePreviews(const Scene& scene, const LabOptions& o);
 // Times each function `repeats` times, one call of each per round (round-robin), so a
 // drift in the machine's load is shared by all of them. One Timing per function.
 std::vector<Timing> measureInterleaved(int repeats, const std::vector<std::function<void()>>& fns);
+// The same, the raw samples: samples[i][round] in seconds (for ratios taken per round).
+std::vector<std::vector<double>> sampleInterleaved(int repeats,
+                                                   const std::vector<std::function<void()>>& fns);
 
 // How work is handed to threads.
 enum class Schedule { StaticRows, DynamicRows, DynamicTiles };

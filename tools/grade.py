@@ -1,7 +1,7 @@
 #!/usr/bin/python3
 """Grades a student's tree against the workbook's reference tests.
 
-usage: tools/grade.py STUDENT_TREE [--hidden DIR] [--junit FILE] [--timeout S]
+usage: tools/grade.py STUDENT_TREE [--hidden DIR] [--junit FILE] [--json FILE] [--timeout S]
                       [--steps 01,02] [--work DIR] [--jobs N]
        (./workbook grade ...)
 
@@ -19,10 +19,13 @@ test case of an "exercise N.M" suite runs as its own process with a time limit; 
 earns its points (from the reference's markers) when it has test cases and all of them pass.
 The tests run under bubblewrap where it works (the files read-only but a private /tmp, no
 network) and write their results to a file, so what the student's code prints is not read.
-The points table goes to the terminal, a JUnit XML file to --junit (default WORK/grade.xml).
+The points table goes to the terminal, a JUnit XML file to --junit (default WORK/grade.xml),
+and with --json FILE the same results per exercise as JSON (exercise, points, max, status,
+reason, seconds).
 WORK/build is kept between runs, so grading the next tree rebuilds only what changed.
 """
 import argparse
+import json
 import os
 import re
 import shutil
@@ -285,6 +288,25 @@ def write_junit(path, rows, notes, seconds):
     ET.ElementTree(suites).write(path, encoding="utf-8", xml_declaration=True)
 
 
+def write_json(path, rows, notes, seconds):
+    """The per-exercise results as JSON, for batch grading and other tools: one object per
+    exercise with its points earned (0 unless passed), max, status ("passed" or "failed"),
+    reason (empty when passed) and seconds."""
+    doc = {"points": sum(r["points"] for r in rows if r["passed"]),
+           "max": sum(r["points"] for r in rows), "seconds": round(seconds, 2),
+           "exercises": [{"exercise": r["id"], "title": r["title"], "step": r["step"],
+                          "points": r["points"] if r["passed"] else 0, "max": r["points"],
+                          "status": "passed" if r["passed"] else "failed",
+                          "reason": "" if r["passed"] else r["message"],
+                          "case": r.get("case", ""), "seconds": round(r["seconds"], 2)}
+                         for r in rows],
+           "notes": list(notes)}
+    os.makedirs(os.path.dirname(os.path.abspath(path)), exist_ok=True)
+    with open(path, "w", encoding="utf-8") as f:
+        json.dump(doc, f, indent=2)
+        f.write("\n")
+
+
 def grade(args):
     started = time.monotonic()
     student = os.path.abspath(args.student)
@@ -348,6 +370,8 @@ def grade(args):
     earned, total = print_table(rows, notes)
     junit = args.junit or os.path.join(work, "grade.xml")
     write_junit(junit, rows, notes, time.monotonic() - started)
+    if args.json:
+        write_json(args.json, rows, notes, time.monotonic() - started)
     say(f"{earned} of {total} points; JUnit XML: {junit}")
     return 0
 
@@ -359,6 +383,7 @@ def main(argv):
     p.add_argument("student", help="the student's workbook tree (a starter kit with their work)")
     p.add_argument("--hidden", help="folder of extra doctest files stepNN*.cpp")
     p.add_argument("--junit", help="JUnit XML file to write (default WORK/grade.xml)")
+    p.add_argument("--json", help="also write the per-exercise results as JSON to this file")
     p.add_argument("--timeout", type=float, default=60.0, help="seconds per test case (default 60)")
     p.add_argument("--steps", help="grade only these steps, e.g. 01,03")
     p.add_argument("--work", help="where the grading tree and its build live (default build/grade)")

@@ -2,7 +2,8 @@
 """Grades a student's tree against the workbook's reference tests.
 
 usage: tools/grade.py STUDENT_TREE [--hidden DIR] [--junit FILE] [--json FILE] [--timeout S]
-                      [--steps 01,02] [--work DIR] [--jobs N]
+                      [--memory MB] [--output MB] [--build-timeout S] [--build-memory MB]
+                      [--steps 01,02] [--work DIR] [--jobs N] [--no-isolation]
        (./workbook grade ...)
 
 What the student owns: the C++ sources and headers in the step folders (steps/NN_name/*.cpp,
@@ -15,13 +16,22 @@ test program (test_stepNN) and its TEST_SUITE("exercise N.M") cases count for ex
 
 Each step's test program is built on its own, so a step that does not compile scores zero
 for its exercises (with the compiler's first error) and the other steps are still graded. Each
-test case of an "exercise N.M" suite runs as its own process with a time limit; an exercise
-earns its points (from the reference's markers) when it has test cases and all of them pass.
-The tests run under bubblewrap where it works (the files read-only but a private /tmp, no
-network) and write their results to a file, so what the student's code prints is not read.
-The points table goes to the terminal, a JUnit XML file to --junit (default WORK/grade.xml),
-and with --json FILE the same results per exercise as JSON (exercise, points, max, status,
-reason, seconds).
+test case of an "exercise N.M" suite runs as its own process; an exercise earns its points
+(from the reference's markers) when it has test cases and all of them pass.
+
+The student's code is untrusted: the configure, every build (the compilers read the
+student's sources) and every test case run in tools/sandbox.py's sandbox (bubblewrap: the
+system read-only, one writable folder: WORK/build for a build, a fresh folder per test
+case; a private /tmp, no network, no capabilities) with limits on wall-clock and CPU time,
+memory (address space) and output (--timeout, --memory, --output per test case;
+--build-timeout, --build-memory per step's build). Where bubblewrap cannot create
+namespaces the grader says so and refuses, unless --no-isolation. The tests write their
+results to a file, so what the student's code prints only counts against the output limit.
+A failing exercise says why: time limit, memory limit, output limit, crashed: SIGNAME,
+failed: <first failing assertion>, does not compile: <first error or the limit it hit>.
+The points table goes to the terminal, a JUnit XML file to --junit (default WORK/grade.xml;
+the reason is each failure's message), and with --json FILE the same results per exercise
+as JSON (exercise, title, step, points, max, status, reason, case, seconds).
 WORK/build is kept between runs, so grading the next tree rebuilds only what changed.
 """
 import argparse
@@ -158,25 +168,35 @@ class Isolation:
     build: sandbox.Limits
     test: sandbox.Limits
     jobs: int = 2
+    # What student code must not read: the reference tree (the solutions), the student's own
+    # tree, the instructor's hidden tests and home folders. It reads the grading tree instead
+    # (a build: WORK/src and WORK/build; a test: WORK/build and the data).
+    hidden: tuple = ()
 
 
 def clean_env(home):
     """The environment student code sees: no secrets of the instructor's shell."""
     env = {k: v for k, v in os.environ.items() if k in ("PATH", "LANG", "LC_ALL", "CC", "CXX", "TZ")}
     env.setdefault("PATH", "/usr/local/bin:/usr/bin:/bin")
-    env.update(HOME=home, TMPDIR="/tmp")
+    # glibc's malloc keeps up to 8 arenas of 64 MB address space per core: on a many-core
+    # machine that alone would pass the memory limit.
+    env.update(HOME=home, TMPDIR="/tmp", MALLOC_ARENA_MAX="2")
     return env
 
 
 def build_reason(result, output, src):
-    """'does not compile: ...' for a failed build: a limit it hit, or the first error."""
-    error = first_error(output, src) if output.strip() else ""
+    """'does not compile: ...' for a failed build: a limit it hit (with the source being
+    compiled then), or the compiler's first error."""
     if result.status in ("time limit", "memory limit", "output limit", "crashed"):
-        limit = result.reason
+        compiling = re.findall(r" -c (\S+\.(?:cpp|cc|cxx))\b", output)
+        where = f" (compiling {compiling[-1].replace(src + '/', '')})" if compiling else ""
         if result.status == "time limit":
-            limit += " (the build ran over its time)"
-        return f"does not compile: {limit}" + (f": {error}" if error and error != "the build failed" else "")
-    return f"does not compile: {error or 'the build failed'}"
+            where += f" (the build ran over {result.seconds:.0f} s)"
+        elif result.status == "output limit":
+            error = first_error(output, src)
+            where += f": {error}" if error != "the build failed" else ""
+        return f"does not compile: {result.reason}{where}"
+    return f"does not compile: {first_error(output, src)}"
 
 
 def configure(work, iso):
@@ -189,7 +209,8 @@ def configure(work, iso):
     os.makedirs(build, exist_ok=True)
     r = sandbox.run(["cmake", "-S", os.path.join(work, "src"), "-B", build, "-G", "Ninja",
                      "-DCMAKE_BUILD_TYPE=Release"], iso.build, writable=[build],
-                    isolate=iso.isolate, env=clean_env(build))
+                    isolate=iso.isolate, env=clean_env(build), hidden=iso.hidden,
+                    readable=[os.path.join(work, "src")])
     if not r.ok:
         sys.stderr.write((r.stdout + r.stderr).decode(errors="replace"))
         raise SystemExit(f"grade: configuring the grading tree failed ({r.reason}; see above)")
@@ -215,7 +236,8 @@ def build_step(work, number, iso):
     WORK/build, within the build limits."""
     build = os.path.join(work, "build")
     r = sandbox.run(["cmake", "--build", build, "--target", f"test_step{number}", "--", f"-j{iso.jobs}"],
-                    iso.build, writable=[build], isolate=iso.isolate, env=clean_env(build))
+                    iso.build, writable=[build], isolate=iso.isolate, env=clean_env(build),
+                    hidden=iso.hidden, readable=[os.path.join(work, "src")])
     if r.ok:
         return ""
     output = (r.stdout + r.stderr).decode(errors="replace")
@@ -224,12 +246,19 @@ def build_step(work, number, iso):
     return build_reason(r, output, os.path.join(work, "src"))
 
 
+def test_readable(binary):
+    """What a test program reads: its build tree (WORK/build) and the data (WORK/src/data)."""
+    build = os.path.dirname(os.path.dirname(binary))
+    return [build, os.path.join(os.path.dirname(build), "src", "data")]
+
+
 def list_cases(binary, iso, folder):
     """[(suite, test case)] of a test program, or raises RuntimeError saying why not."""
     os.makedirs(folder, exist_ok=True)
     limits = sandbox.Limits(max(iso.test.seconds, 60.0), iso.test.memory_mb, iso.test.output_mb)
     r = sandbox.run([binary, "--list-test-cases", "--reporters=xml"], limits, writable=[folder],
-                    isolate=iso.isolate, env=clean_env(folder), keep=int(limits.output_mb * (1 << 20)))
+                    isolate=iso.isolate, env=clean_env(folder), keep=int(limits.output_mb * (1 << 20)),
+                    hidden=iso.hidden, readable=test_readable(binary))
     try:
         root = ET.fromstring(r.stdout.decode(errors="replace"))
     except ET.ParseError as e:
@@ -258,7 +287,7 @@ def run_case(binary, suite, name, iso, folder):
     cmd = [binary, f"--test-suite={suite}", f"--test-case={name}", "--reporters=xml",
            "--no-version", f"--out={result}"]
     r = sandbox.run(cmd, iso.test, writable=[folder], isolate=iso.isolate, env=clean_env(folder),
-                    keep=1 << 16)
+                    keep=1 << 16, hidden=iso.hidden, readable=test_readable(binary))
     found = [c for c in case_results(result) if c.name == name] if os.path.exists(result) else []
     shutil.rmtree(folder, ignore_errors=True)
     if r.status in ("time limit", "memory limit", "output limit", "crashed"):
@@ -362,6 +391,7 @@ def exercise_row(e, number, build_error, outcomes, seconds):
         status, reason, case = failed[0].status, failed[0].reason, failed[0].name
     else:
         status, reason, case = "passed", "", ""
+    reason = reason if len(reason) <= 500 else reason[:497] + "..."
     message = reason + (f' (test case "{case}")' if case else "")
     details = [f"{'passed' if o.passed else 'FAILED'}: {o.name}" + ("" if o.passed else f": {o.reason}")
                for o in outcomes] or [message]
@@ -399,7 +429,9 @@ def grade(args):
     refuse_without_isolation(args)
     iso = Isolation(not args.no_isolation,
                     build=sandbox.Limits(args.build_timeout, args.build_memory, args.output, file_mb=2048),
-                    test=sandbox.Limits(args.timeout, args.memory, args.output), jobs=args.jobs)
+                    test=sandbox.Limits(args.timeout, args.memory, args.output), jobs=args.jobs,
+                    hidden=tuple(p for p in (ROOT, student, args.hidden and os.path.abspath(args.hidden),
+                                             os.path.expanduser("~"), "/home", "/root") if p))
     notes = assemble(student, args.hidden and os.path.abspath(args.hidden), work, steps)
     if not iso.isolate:
         notes.append("student code ran without isolation (--no-isolation)")

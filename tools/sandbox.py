@@ -91,13 +91,25 @@ def _namespaces():
             "--cap-drop", "ALL", "--disable-userns", "--die-with-parent", "--new-session"]
 
 
-def bwrap_prefix(writable, cwd, tmp_bytes):
-    """bubblewrap arguments: the system read-only, `writable` folders read-write, a private
-    /tmp of tmp_bytes, /dev and /proc of the sandbox's own."""
-    prefix = [bwrap_program(), "--ro-bind", "/", "/", "--dev", "/dev", "--proc", "/proc",
-              "--size", str(int(tmp_bytes)), "--tmpfs", "/tmp"]
+def bwrap_prefix(writable, cwd, tmp_bytes, hidden=(), readable=()):
+    """bubblewrap arguments: the system read-only, `hidden` folders replaced by empty ones,
+    `readable` folders (inside hidden ones) shown again read-only, `writable` folders
+    read-write, a private /tmp of tmp_bytes, /dev and /proc of the sandbox's own."""
+    prefix = [bwrap_program(), "--ro-bind", "/", "/", "--dev", "/dev", "--proc", "/proc"]
+    covers = []
+    for d in hidden:
+        inside_another = any(d != h and d.startswith(h.rstrip("/") + "/") for h in list(hidden) + ["/tmp"])
+        if os.path.isdir(d) and d not in ("/", "/tmp") and not inside_another:
+            covers.append(d)
+            prefix += ["--tmpfs", d]
+    prefix += ["--size", str(int(tmp_bytes)), "--tmpfs", "/tmp"]
+    for d in readable:
+        if os.path.exists(d):
+            prefix += ["--ro-bind", d, d]
     for d in writable:
         prefix += ["--bind", d, d]
+    for d in covers:  # the empty covers stay read-only (after the binds made their mount points)
+        prefix += ["--remount-ro", d]
     return prefix + ["--chdir", cwd] + _namespaces()
 
 
@@ -119,15 +131,20 @@ def _signal_name(number):
         return f"signal {number}"
 
 
-def run(cmd, limits, writable=(), cwd=None, isolate=True, keep=1 << 20, env=None):
+def run(cmd, limits, writable=(), cwd=None, isolate=True, keep=1 << 20, env=None, hidden=(),
+        readable=()):
     """Runs cmd under the sandbox and limits; returns a Result. `writable`: the folders the
-    command may write (cwd, default the first of them, is one of them when isolated)."""
+    command may write (cwd, default the first of them, is one of them when isolated);
+    `hidden`: folders it must not read (they look empty), `readable`: folders inside those
+    it reads after all."""
     writable = [os.path.abspath(d) for d in writable]
+    hidden = [os.path.abspath(d) for d in hidden]
+    readable = [os.path.abspath(d) for d in readable]
     cwd = os.path.abspath(cwd or (writable[0] if writable else os.getcwd()))
     output_bytes = int(limits.output_mb * (1 << 20))
     full = list(cmd)
     if isolate:
-        full = bwrap_prefix(writable or [cwd], cwd, output_bytes) + ["--"] + full
+        full = bwrap_prefix(writable or [cwd], cwd, output_bytes, hidden, readable) + ["--"] + full
     started = time.monotonic()
     try:
         p = subprocess.Popen(full, cwd=cwd, stdin=subprocess.DEVNULL, stdout=subprocess.PIPE,

@@ -8,7 +8,8 @@ usage: tests/grading_test.py SCENARIO WORK_DIR
   one-solved     a kit with one exercise solved scores exactly that exercise's points
   compile-error  a step that does not compile scores zero with the compiler's error; the
                  other graded steps keep their points
-  hidden         an instructor's hidden tests count, and a hanging test case times out
+  hidden         an instructor's hidden tests count (also one named with a comma), and a
+                 hanging test case stops at the time limit
   hostile-loop, hostile-segv, hostile-memory, hostile-files, hostile-read, hostile-network,
   hostile-output, hostile-compile, hostile-compile-time
                  the reference with one exercise's solution replaced by hostile code (an
@@ -235,6 +236,8 @@ def scenario_hidden(work):
             f.write("#include <doctest/doctest.h>\n#include <chrono>\n#include <thread>\n"
                     f'TEST_SUITE("exercise {failing}") {{\n'
                     '    TEST_CASE("hidden: an instructor check") { CHECK(1 + 1 == 3); }\n}\n'
+                    f'TEST_SUITE("exercise {ids[1]}") {{\n'
+                    '    TEST_CASE("hidden: a name with a comma, which doctest filters split") { CHECK(true); }\n}\n'
                     f'TEST_SUITE("exercise {hanging}") {{\n'
                     '    TEST_CASE("hidden: a test that never ends") {\n'
                     "        for (;;) std::this_thread::sleep_for(std::chrono::milliseconds(10));\n"

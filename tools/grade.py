@@ -278,14 +278,19 @@ class CaseOutcome:
         return self.status == "passed"
 
 
+def doctest_filter(name):
+    """doctest splits a filter at commas: a comma inside a name is escaped."""
+    return name.replace(",", "\\,")
+
+
 def run_case(binary, suite, name, iso, folder):
     """One test case in its own sandboxed process, in a fresh writable folder, with the test
     limits. doctest writes its results to a file there, so what the student's code prints is
     only counted against the output limit, never read as a result."""
     os.makedirs(folder)
     result = os.path.join(folder, "result.xml")
-    cmd = [binary, f"--test-suite={suite}", f"--test-case={name}", "--reporters=xml",
-           "--no-version", f"--out={result}"]
+    cmd = [binary, "--test-suite=" + doctest_filter(suite), "--test-case=" + doctest_filter(name),
+           "--reporters=xml", "--no-version", f"--out={result}"]
     r = sandbox.run(cmd, iso.test, writable=[folder], isolate=iso.isolate, env=clean_env(folder),
                     keep=1 << 16, hidden=iso.hidden, readable=test_readable(binary))
     found = [c for c in case_results(result) if c.name == name] if os.path.exists(result) else []

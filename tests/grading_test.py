@@ -11,11 +11,12 @@ usage: tests/grading_test.py SCENARIO WORK_DIR
   hidden         an instructor's hidden tests count (also one named with a comma), and a
                  hanging test case stops at the time limit
   hostile-loop, hostile-segv, hostile-memory, hostile-files, hostile-read, hostile-network,
-  hostile-output, hostile-compile, hostile-compile-time
+  hostile-output, hostile-static, hostile-compile, hostile-compile-time
                  the reference with one exercise's solution replaced by hostile code (an
                  endless loop, a null-pointer write, allocating without limit, writing files
                  outside its folder, reading the solutions, the network, printing without
-                 end, a compile that eats memory, a compile that never ends): the report is
+                 end, a global object that never ends its constructor, a compile that eats
+                 memory, a compile that never ends): the report is
                  complete, the other exercises keep their points, the hostile one scores
                  zero with its reason, and nothing outside the sandbox changed (skipped,
                  exit 77, where bubblewrap cannot run)
@@ -327,6 +328,8 @@ def hostile_body(kind, token, work, port):
     if kind == "output":
         return ["std::string line(1 << 16, 'x');", "line.back() = '\\n';",
                 "for (;;) std::fwrite(line.data(), 1, line.size(), stdout);"]
+    if kind == "static":  # the solution kept; a global object that never ends its constructor
+        return None
     if kind == "compile":
         return ['#include "/dev/zero"']
     if kind == "compile-time":  # some 10^10 steps of constant evaluation: minutes of GCC
@@ -366,7 +369,10 @@ def hostile_tree(dest, exercise, body):
     path = os.path.join(dest, exercise.path)
     with open(path, encoding="utf-8") as f:
         lines = f.read().split("\n")
-    lines[exercise.begin + 1:exercise.end] = ["    " + l for l in body]
+    if body is None:  # runs before any test: at the program's start
+        lines.append("namespace { struct Spin { Spin() { for (volatile int i = 0;; i = i + 1) {} } } spin; }")
+    else:
+        lines[exercise.begin + 1:exercise.end] = ["    " + l for l in body]
     with open(path, "w", encoding="utf-8") as f:
         f.write(HOSTILE_INCLUDES + "\n".join(lines))
 
@@ -393,6 +399,8 @@ HOSTILE = {
     "read": ("failed", "cannot read", []),
     "network": ("failed", "connect: ", []),
     "output": ("output limit", "output limit", ["--output", "4"]),
+    "static": ("time limit", "time limit (the test program does not list its tests)",
+               ["--timeout", "3", "--build-timeout", "120"]),
     "compile": ("does not compile", "does not compile: memory limit", ["--build-memory", "1024"]),
     "compile-time": ("does not compile", "does not compile: time limit", ["--build-timeout", "10"]),
 }
@@ -439,9 +447,9 @@ def scenario_hostile(work, kind):
           f"{kind}: exercise {hostile.id} scores 0: {got.get('status')!r}, {got.get('reason', '')[:300]!r}")
     lines = {l.split()[0]: l for l in r.stdout.splitlines() if l[:1].isdigit()}
     check(want_text.split(":")[0] in lines.get(hostile.id, ""), f"{kind}: the table says why: {lines.get(hostile.id)!r}")
-    if kind.startswith("compile"):  # the whole step does not compile; the report is still complete
-        check(all(results.get(i, {}).get("status") == "does not compile" for i in ids),
-              f"{kind}: every exercise of step {first} does not compile")
+    if kind.startswith("compile") or kind == "static":  # the whole step fails; the report is complete
+        check(all(results.get(i, {}).get("status") == want_status for i in ids),
+              f"{kind}: every exercise of step {first}: {want_status}")
     else:
         others = [i for i in ids if i != hostile.id]
         check(all(results.get(i, {}).get("status") == "passed" for i in others),

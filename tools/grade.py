@@ -201,20 +201,22 @@ def build_reason(result, output, src):
 
 def configure(work, iso):
     """Configures the grading tree once (sandboxed like the builds: it reads the reference's
-    CMake files, but writes only WORK/build). Returns '' or the reason it failed."""
+    CMake files, but writes only WORK/build); exits with the reason when that fails."""
     build = os.path.join(work, "build")
-    if os.path.exists(os.path.join(build, "build.ninja")):
-        return ""
+    cache = os.path.join(build, "CMakeCache.txt")
+    if os.path.exists(os.path.join(build, "build.ninja")) and "BOXES_GRADING:BOOL=ON" in (
+            read(cache) if os.path.exists(cache) else ""):
+        return
     say("configuring the grading tree (once; later grades reuse it)")
     os.makedirs(build, exist_ok=True)
+    # BOXES_GRADING: no ctest discovery, which would run the student's code in the build.
     r = sandbox.run(["cmake", "-S", os.path.join(work, "src"), "-B", build, "-G", "Ninja",
-                     "-DCMAKE_BUILD_TYPE=Release"], iso.build, writable=[build],
+                     "-DCMAKE_BUILD_TYPE=Release", "-DBOXES_GRADING=ON"], iso.build, writable=[build],
                     isolate=iso.isolate, env=clean_env(build), hidden=iso.hidden,
                     readable=[os.path.join(work, "src")])
     if not r.ok:
         sys.stderr.write((r.stdout + r.stderr).decode(errors="replace"))
         raise SystemExit(f"grade: configuring the grading tree failed ({r.reason}; see above)")
-    return ""
 
 
 def first_error(output, src):
@@ -255,14 +257,17 @@ def test_readable(binary):
 def list_cases(binary, iso, folder):
     """[(suite, test case)] of a test program, or raises RuntimeError saying why not."""
     os.makedirs(folder, exist_ok=True)
-    limits = sandbox.Limits(max(iso.test.seconds, 60.0), iso.test.memory_mb, iso.test.output_mb)
+    limits = iso.test
     r = sandbox.run([binary, "--list-test-cases", "--reporters=xml"], limits, writable=[folder],
                     isolate=iso.isolate, env=clean_env(folder), keep=int(limits.output_mb * (1 << 20)),
                     hidden=iso.hidden, readable=test_readable(binary))
     try:
         root = ET.fromstring(r.stdout.decode(errors="replace"))
     except ET.ParseError as e:
-        raise RuntimeError(f"the test program does not list its tests ({r.reason})") from e
+        # Before any test runs: the student's code in a global object's constructor, say.
+        status = r.status if r.status not in ("ok", "failed") else "failed"
+        reason = r.reason if status != "failed" else f"failed: {r.reason}"
+        raise RuntimeError(status, f"{reason} (the test program does not list its tests)") from e
     return [(c.get("testsuite", ""), c.get("name", "")) for c in root.iter("TestCase")]
 
 
@@ -383,13 +388,13 @@ def write_json(path, rows, notes, seconds):
 
 def exercise_row(e, number, build_error, outcomes, seconds):
     """The report's row of one exercise: passed when it has test cases and all pass; else the
-    reason of its first failing case (or of its step's build)."""
+    reason of its first failing case, of its step's build ('does not compile: ...'), or
+    (status, reason) of a test program that does not start."""
     failed = [o for o in outcomes if not o.passed]
-    if build_error:
+    if isinstance(build_error, tuple):  # the test program does not start
+        (status, reason), case = build_error, ""
+    elif build_error:
         status, reason, case = "does not compile", build_error, ""
-        if build_error.startswith("the test program"):
-            status = "crashed" if "crashed" in build_error else "failed"
-            reason = f"failed: {build_error}"
     elif not outcomes:
         status, reason, case = "no tests", "no test cases for this exercise", ""
     elif failed:
@@ -435,8 +440,8 @@ def grade(args):
     iso = Isolation(not args.no_isolation,
                     build=sandbox.Limits(args.build_timeout, args.build_memory, args.output, file_mb=2048),
                     test=sandbox.Limits(args.timeout, args.memory, args.output), jobs=args.jobs,
-                    hidden=tuple(p for p in (ROOT, student, args.hidden and os.path.abspath(args.hidden),
-                                             os.path.expanduser("~"), "/home", "/root") if p))
+                    hidden=tuple(dict.fromkeys(p for p in (ROOT, student, args.hidden and os.path.abspath(args.hidden),
+                                                           os.path.expanduser("~"), "/home", "/root") if p)))
     notes = assemble(student, args.hidden and os.path.abspath(args.hidden), work, steps)
     if not iso.isolate:
         notes.append("student code ran without isolation (--no-isolation)")
@@ -455,7 +460,7 @@ def grade(args):
                     cases = [(s, n) for s, n in list_cases(binary, iso, os.path.join(scratch, "list"))
                              if s.startswith("exercise ")]
                 except RuntimeError as e:
-                    error, cases = str(e), []
+                    error, cases = tuple(e.args), []
                 say(f"step {number}: running {len(cases)} test cases")
                 for i, (suite, name) in enumerate(cases):
                     ex = suite.split(" ", 1)[1]

@@ -437,12 +437,13 @@ def grade(args):
         raise SystemExit(f"grade: --steps {','.join(unknown)}: no such step with exercises "
                          f"(steps: {','.join(numbers)})")
     refuse_without_isolation(args)
+    hidden = args.hidden and os.path.abspath(args.hidden)
+    unreadable = (ROOT, student, hidden, os.path.expanduser("~"), "/home", "/root")
     iso = Isolation(not args.no_isolation,
                     build=sandbox.Limits(args.build_timeout, args.build_memory, args.output, file_mb=2048),
                     test=sandbox.Limits(args.timeout, args.memory, args.output), jobs=args.jobs,
-                    hidden=tuple(dict.fromkeys(p for p in (ROOT, student, args.hidden and os.path.abspath(args.hidden),
-                                                           os.path.expanduser("~"), "/home", "/root") if p)))
-    notes = assemble(student, args.hidden and os.path.abspath(args.hidden), work, steps)
+                    hidden=tuple(dict.fromkeys(p for p in unreadable if p)))
+    notes = assemble(student, hidden, work, steps)
     if not iso.isolate:
         notes.append("student code ran without isolation (--no-isolation)")
     configure(work, iso)

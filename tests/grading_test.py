@@ -8,24 +8,43 @@ usage: tests/grading_test.py SCENARIO WORK_DIR
   one-solved     a kit with one exercise solved scores exactly that exercise's points
   compile-error  a step that does not compile scores zero with the compiler's error; the
                  other graded steps keep their points
-  hidden         an instructor's hidden tests count, and a hanging test case times out
+  hidden         an instructor's hidden tests count (also one named with a comma), and a
+                 hanging test case stops at the time limit
+  hostile-loop, hostile-segv, hostile-memory, hostile-files, hostile-read, hostile-network,
+  hostile-output, hostile-static, hostile-compile, hostile-compile-time
+                 the reference with one exercise's solution replaced by hostile code (an
+                 endless loop, a null-pointer write, allocating without limit, writing files
+                 outside its folder, reading the solutions, the network, printing without
+                 end, a global object that never ends its constructor, a compile that eats
+                 memory, a compile that never ends): the report is
+                 complete, the other exercises keep their points, the hostile one scores
+                 zero with its reason, and nothing outside the sandbox changed (skipped,
+                 exit 77, where bubblewrap cannot run)
+  no-isolation   where bubblewrap cannot create namespaces (a fake bwrap that fails) the
+                 grader refuses in one line, and grades with --no-isolation
   each-solved    (by hand, not in ctest) each exercise solved alone scores exactly its points
 
 The steps are discovered, not named: grading scenarios use the first step with exercises
 (and the last one for the compile error), so they keep working as steps are added. All
 grading scenarios share one grading build in WORK_DIR (ctest runs them one at a time).
 """
+import json
 import os
+import socket
 import shutil
 import subprocess
 import sys
 import tempfile
+import time
 import xml.etree.ElementTree as ET
 
 ROOT = os.path.dirname(os.path.dirname(os.path.abspath(__file__)))
 sys.path.insert(0, os.path.join(ROOT, "tools"))
 from exercises import BEGIN, END, exercises, step_dirs, step_sources  # noqa: E402
 from kit import strip_solutions, write_kit  # noqa: E402
+from sandbox import isolation_problem  # noqa: E402
+
+SKIPPED = 77  # ctest's SKIP_RETURN_CODE
 
 failures = []
 
@@ -61,9 +80,19 @@ def student_tree(dest, keep=None, break_step=None):
     return None
 
 
+def isolation_flags():
+    """The grading scenarios test grading, not isolation: where bubblewrap cannot run they
+    grade without it (the hostile scenarios are skipped there instead)."""
+    problem = isolation_problem()
+    if problem:
+        print(f"note: {problem}: grading with --no-isolation")
+        return ["--no-isolation"]
+    return []
+
+
 def grade(student, work, steps, junit):
     cmd = [sys.executable, os.path.join(ROOT, "tools", "grade.py"), student, "--work", work,
-           "--steps", ",".join(steps), "--junit", junit, "--timeout", "120"]
+           "--steps", ",".join(steps), "--junit", junit, "--timeout", "120"] + isolation_flags()
     r = subprocess.run(cmd, capture_output=True, text=True)
     print(r.stdout)
     if r.returncode != 0:
@@ -188,7 +217,7 @@ def scenario_compile_error(work):
             continue
         passed, message = results.get(e.id, (None, ""))
         if step == broken:
-            check(passed is False and f"step {broken} does not build" in message
+            check(passed is False and message.startswith("does not compile: ")
                   and os.path.basename(path) in message and "error" in message,
                   f"compile error: exercise {e.id} scores zero with the compiler's first error: {message!r}")
         else:
@@ -208,24 +237,279 @@ def scenario_hidden(work):
             f.write("#include <doctest/doctest.h>\n#include <chrono>\n#include <thread>\n"
                     f'TEST_SUITE("exercise {failing}") {{\n'
                     '    TEST_CASE("hidden: an instructor check") { CHECK(1 + 1 == 3); }\n}\n'
+                    f'TEST_SUITE("exercise {ids[1]}") {{\n'
+                    '    TEST_CASE("hidden: a name with a comma, which doctest filters split") { CHECK(true); }\n}\n'
                     f'TEST_SUITE("exercise {hanging}") {{\n'
                     '    TEST_CASE("hidden: a test that never ends") {\n'
                     "        for (;;) std::this_thread::sleep_for(std::chrono::milliseconds(10));\n"
                     "    }\n}\n")
         cmd = [sys.executable, os.path.join(ROOT, "tools", "grade.py"), ROOT, "--work", work,
                "--steps", first, "--junit", os.path.join(work, "hidden.xml"), "--timeout", "3",
-               "--hidden", hidden]
+               "--hidden", hidden] + isolation_flags()
         r = subprocess.run(cmd, capture_output=True, text=True)
     print(r.stdout, r.stderr)
     check(r.returncode == 0, "grade.py with --hidden exits 0")
     lines = {l.split()[0]: l for l in r.stdout.splitlines() if l[:1].isdigit()}
     check("hidden: an instructor check" in lines.get(failing, "") and "FAILED" in lines.get(failing, ""),
           f"hidden: exercise {failing} fails on the hidden check")
-    check("timed out after 3 s" in lines.get(hanging, ""), f"hidden: exercise {hanging} times out")
+    check("time limit" in lines.get(hanging, ""), f"hidden: exercise {hanging} stops at the time limit")
     others = [i for i in ids if i not in (failing, hanging)]
     check(all("passed" in lines.get(i, "") for i in others), "hidden: the other exercises pass")
     expected = points(others)
     check(f"Grade: {expected} of {points(ids)} points" in r.stdout, f"hidden: {expected} points")
+
+
+# Hostile student trees ------------------------------------------------------------------------
+
+HOSTILE_INCLUDES = "".join(f"#include <{h}>\n" for h in (
+    "arpa/inet.h", "netdb.h", "netinet/in.h", "sys/socket.h", "unistd.h", "cerrno", "cstdint",
+    "cstdio", "cstring", "stdexcept", "string", "vector"))
+
+
+def c_string(text):
+    return json.dumps(text)  # a C string literal for plain ASCII paths
+
+
+def hostile_body(kind, token, work, port):
+    """The statements that replace the hostile exercise's solution: each either never returns
+    or throws, so it compiles in any function whatever its return type."""
+    if kind == "loop":
+        return ["for (volatile unsigned long spin = 0;; spin = spin + 1) {", "}"]
+    if kind == "segv":
+        return ["volatile std::uintptr_t address = 0;",
+                "*reinterpret_cast<volatile int*>(address) = 1;  // a null-pointer write",
+                'throw std::logic_error("survived a null-pointer write");']
+    if kind == "memory":
+        return ["std::vector<char*> blocks;", "for (;;) {",
+                "    char* block = new char[1 << 24];",
+                "    for (int i = 0; i < (1 << 24); i += 4096) reinterpret_cast<volatile char*>(block)[i] = 1;",
+                "    blocks.push_back(block);", "}"]
+    if kind == "files":
+        paths = ", ".join(c_string(p) for p in hostile_paths(token, work))
+        return ["std::string report;",
+                f"for (const char* path : {{{paths}}}) {{",
+                '    if (std::FILE* f = std::fopen(path, "a")) {',
+                '        std::fputs("written by hostile student code\\n", f);',
+                "        std::fclose(f);",
+                '        report += std::string("wrote ") + path + "; ";',
+                "    } else {",
+                '        report += std::string(path) + ": " + std::strerror(errno) + "; ";',
+                "    }", "}",
+                f"if (std::remove({c_string(canary_path(work))}) == 0) report += \"removed the canary; \";",
+                "throw std::runtime_error(report);"]
+    if kind == "read":  # the reference solutions, the grader, the tests' sources
+        paths = ", ".join(c_string(p) for p in secret_paths(work))
+        return ["std::string report;",
+                f"for (const char* path : {{{paths}}}) {{",
+                '    if (std::FILE* f = std::fopen(path, "r")) {',
+                '        report += std::string("read ") + path + "; ";',
+                "        std::fclose(f);",
+                "    } else {",
+                '        report += std::string("cannot read ") + path + " (" + std::strerror(errno) + "); ";',
+                "    }", "}",
+                "throw std::runtime_error(report);"]
+    if kind == "network":
+        return ["std::string report;",
+                "int s = socket(AF_INET, SOCK_STREAM, 0);",
+                "sockaddr_in address{};",
+                "address.sin_family = AF_INET;",
+                f"address.sin_port = htons({port});",
+                'inet_pton(AF_INET, "127.0.0.1", &address.sin_addr);',
+                "if (s >= 0 && connect(s, reinterpret_cast<sockaddr*>(&address), sizeof address) == 0)",
+                '    report += "connected to the listener; ";',
+                "else",
+                '    report += std::string("connect: ") + std::strerror(errno) + "; ";',
+                "if (s >= 0) close(s);",
+                "addrinfo* found = nullptr;",
+                'int rc = getaddrinfo("example.com", "80", nullptr, &found);',
+                'if (rc == 0) { report += "resolved example.com"; freeaddrinfo(found); }',
+                'else report += std::string("resolve example.com: ") + gai_strerror(rc);',
+                "throw std::runtime_error(report);"]
+    if kind == "output":
+        return ["std::string line(1 << 16, 'x');", "line.back() = '\\n';",
+                "for (;;) std::fwrite(line.data(), 1, line.size(), stdout);"]
+    if kind == "static":  # the solution kept; a global object that never ends its constructor
+        return None
+    if kind == "compile":
+        return ['#include "/dev/zero"']
+    if kind == "compile-time":  # some 10^10 steps of constant evaluation: minutes of GCC
+        return ["constexpr auto spin = [] {", "    unsigned long n = 0;",
+                "    for (unsigned long i = 0; i < 200000; ++i)",
+                "        for (unsigned long j = 0; j < 200000; ++j) n += i ^ j;",
+                "    return n;", "};", "static_assert(spin() != 1);",
+                'throw std::logic_error("compiled");']
+    raise ValueError(kind)
+
+
+def hostile_paths(token, work):
+    """Where the files scenario tries to write: the instructor's home, the grader's source
+    tree, the shared /tmp and /var/tmp, and the grading tree's build recipe and tests."""
+    name = f"boxes-hostile-{token}"
+    return [os.path.join(os.path.expanduser("~"), name), os.path.join(ROOT, name),
+            os.path.join("/tmp", name), os.path.join("/var/tmp", name), canary_path(work),
+            os.path.join(work, "build", "build.ninja"),
+            os.path.join(work, "src", "tests", "step01_triangle.cpp")]
+
+
+def secret_paths(work):
+    """What the read scenario tries to read: the reference's solutions and the grader's
+    source, and the grading tree's test sources."""
+    first = exercises(ROOT)[0]
+    return [os.path.join(ROOT, first.path), os.path.join(ROOT, "tools", "grade.py"),
+            os.path.join(work, "src", "tests", "step01_triangle.cpp")]
+
+
+def canary_path(work):
+    return os.path.join(work, "canary.txt")
+
+
+def hostile_tree(dest, exercise, body):
+    """The reference's step sources with one exercise's solution replaced by `body`."""
+    student_tree(dest)
+    path = os.path.join(dest, exercise.path)
+    with open(path, encoding="utf-8") as f:
+        lines = f.read().split("\n")
+    if body is None:  # runs before any test: at the program's start
+        lines.append("namespace { struct Spin { Spin() { for (volatile int i = 0;; i = i + 1) {} } } spin; }")
+    else:
+        lines[exercise.begin + 1:exercise.end] = ["    " + l for l in body]
+    with open(path, "w", encoding="utf-8") as f:
+        f.write(HOSTILE_INCLUDES + "\n".join(lines))
+
+
+def snapshot(work):
+    """What must not change: the source tree's git status, the canary and the grading tree's
+    build recipe and test file."""
+    status = subprocess.run(["git", "-C", ROOT, "status", "--porcelain"], capture_output=True,
+                            text=True).stdout
+    files = {}
+    for p in (canary_path(work), os.path.join(work, "build", "build.ninja"),
+              os.path.join(work, "src", "tests", "step01_triangle.cpp")):
+        with open(p, "rb") as f:
+            files[p] = f.read()
+    return status, files
+
+
+# kind: (the expected status, a text the reason contains, extra grade.py flags)
+HOSTILE = {
+    "loop": ("time limit", "time limit", ["--timeout", "4"]),
+    "segv": ("crashed", "crashed: SIGSEGV", []),
+    "memory": ("memory limit", "memory limit", ["--memory", "320"]),
+    "files": ("failed", "Read-only file system", []),
+    "read": ("failed", "cannot read", []),
+    "network": ("failed", "connect: ", []),
+    "output": ("output limit", "output limit", ["--output", "4"]),
+    "static": ("time limit", "time limit (the test program does not list its tests)",
+               ["--timeout", "3", "--build-timeout", "120"]),
+    "compile": ("does not compile", "does not compile: memory limit", ["--build-memory", "1024"]),
+    "compile-time": ("does not compile", "does not compile: time limit", ["--build-timeout", "10"]),
+}
+
+
+def scenario_hostile(work, kind):
+    problem = isolation_problem()
+    if problem:
+        print(f"SKIP: {problem}")
+        return SKIPPED
+    first = steps_with_exercises()[0]
+    ids = [e.id for e in exercises(ROOT) if f"{e.step:02d}" == first]
+    hostile = [e for e in exercises(ROOT) if e.id == ids[-1]][0]
+    want_status, want_text, flags = HOSTILE[kind]
+    token = f"{os.getpid()}-{kind}"
+    listener = socket.socket(socket.AF_INET, socket.SOCK_STREAM)
+    listener.bind(("127.0.0.1", 0))
+    listener.listen(8)
+    listener.setblocking(False)
+    port = listener.getsockname()[1]
+    os.makedirs(os.path.join(work, "build"), exist_ok=True)
+    with open(canary_path(work), "w") as f:
+        f.write("the grader's own file\n")
+    json_path = os.path.join(work, f"hostile-{kind}.json")
+    started = time.monotonic()
+    with tempfile.TemporaryDirectory() as student:
+        hostile_tree(student, hostile, hostile_body(kind, token, work, port))
+        cmd = [sys.executable, os.path.join(ROOT, "tools", "grade.py"), student, "--work", work,
+               "--steps", first, "--junit", os.path.join(work, f"hostile-{kind}.xml"),
+               "--json", json_path, "--timeout", "30"] + flags
+        before = snapshot(work) if os.path.exists(os.path.join(work, "build", "build.ninja")) else None
+        r = subprocess.run(cmd, capture_output=True, text=True, timeout=600)
+    seconds = time.monotonic() - started
+    print(r.stdout, r.stderr[-3000:])
+    check(r.returncode == 0, f"{kind}: grade.py exits 0 ({seconds:.1f} s)")
+    check(len(r.stdout) < 20000, f"{kind}: the report is short ({len(r.stdout)} characters)")
+    results = {}
+    if os.path.exists(json_path):
+        with open(json_path) as f:
+            results = {x["exercise"]: x for x in json.load(f)["exercises"]}
+    check(sorted(results) == sorted(ids), f"{kind}: the report has every exercise of step {first}")
+    got = results.get(hostile.id, {})
+    check(got.get("points") == 0 and got.get("status") == want_status and want_text in got.get("reason", ""),
+          f"{kind}: exercise {hostile.id} scores 0: {got.get('status')!r}, {got.get('reason', '')[:300]!r}")
+    lines = {l.split()[0]: l for l in r.stdout.splitlines() if l[:1].isdigit()}
+    check(want_text.split(":")[0] in lines.get(hostile.id, ""), f"{kind}: the table says why: {lines.get(hostile.id)!r}")
+    if kind.startswith("compile") or kind == "static":  # the whole step fails; the report is complete
+        check(all(results.get(i, {}).get("status") == want_status for i in ids),
+              f"{kind}: every exercise of step {first}: {want_status}")
+    else:
+        others = [i for i in ids if i != hostile.id]
+        check(all(results.get(i, {}).get("status") == "passed" for i in others),
+              f"{kind}: every other exercise passes: " +
+              ", ".join(f"{i} {results.get(i, {}).get('status')}" for i in others))
+        check(f"Grade: {points(others)} of {points(ids)} points" in r.stdout,
+              f"{kind}: {points(others)} of {points(ids)} points")
+    # Nothing outside the sandbox changed.
+    for p in hostile_paths(token, work)[:4]:
+        check(not os.path.exists(p), f"{kind}: no file {p}")
+        if os.path.exists(p):
+            os.remove(p)
+    if before is not None:
+        after = snapshot(work)
+        check(after[0] == before[0], f"{kind}: the source tree's git status did not change")
+        for p, data in before[1].items():
+            check(after[1][p] == data, f"{kind}: {os.path.relpath(p, work)} did not change")
+    if kind == "read":
+        for p in secret_paths(work):
+            check(f"cannot read {p} (No such file or directory)" in got.get("reason", ""),
+                  f"{kind}: {p} is not there for the student's code")
+    if kind == "files":
+        check("wrote /tmp/" in got.get("reason", ""), f"{kind}: the private /tmp was writable (and is gone)")
+    try:
+        connection, _ = listener.accept()
+        connection.close()
+        check(False, f"{kind}: a connection reached the listener on port {port}")
+    except BlockingIOError:
+        check(True, f"{kind}: no connection reached the listener on port {port}")
+    listener.close()
+    return None
+
+
+def scenario_no_isolation(work):
+    """A bubblewrap that cannot create namespaces (a fake one): the grader refuses in one
+    plain line and builds nothing; with --no-isolation it grades."""
+    first = steps_with_exercises()[0]
+    fake = os.path.join(work, "fake-bwrap")
+    with open(fake, "w") as f:
+        f.write("#!/bin/sh\necho 'bwrap: No permissions to create a new namespace' >&2\nexit 1\n")
+    os.chmod(fake, 0o755)
+    env = dict(os.environ, BOXES_BWRAP=fake)
+    json_path = os.path.join(work, "no-isolation.json")
+    if os.path.exists(json_path):
+        os.remove(json_path)
+    base = [sys.executable, os.path.join(ROOT, "tools", "grade.py"), ROOT, "--work", work,
+            "--steps", first, "--json", json_path, "--junit", os.path.join(work, "no-isolation.xml")]
+    r = subprocess.run(base, capture_output=True, text=True, env=env)
+    print(r.stdout, r.stderr)
+    check(r.returncode != 0, f"refused: exit {r.returncode}")
+    check(len(r.stderr.strip().splitlines()) == 1 and "cannot create namespaces" in r.stderr
+          and "--no-isolation" in r.stderr, "refused: one plain line naming the problem and the flag")
+    check(not os.path.exists(json_path) and "Grade:" not in r.stdout, "refused: nothing graded")
+    r = subprocess.run(base + ["--no-isolation"], capture_output=True, text=True, env=env)
+    print(r.stdout, r.stderr)
+    ids = [e.id for e in exercises(ROOT) if f"{e.step:02d}" == first]
+    check(r.returncode == 0 and f"Grade: {points(ids)} of {points(ids)} points" in r.stdout,
+          "--no-isolation: graded, full points")
+    check("without isolation" in r.stdout and "WITHOUT isolation" in r.stderr,
+          "--no-isolation: the report and the terminal say the code ran without isolation")
 
 
 def scenario_each_solved(work):
@@ -249,9 +533,17 @@ def main():
         return 2
     scenario, work = sys.argv[1], os.path.abspath(sys.argv[2])
     os.makedirs(work, exist_ok=True)
-    {"kit": scenario_kit, "reference": scenario_reference, "kit-zero": scenario_kit_zero,
-     "one-solved": scenario_one_solved, "compile-error": scenario_compile_error,
-     "hidden": scenario_hidden, "each-solved": scenario_each_solved}[scenario](work)
+    scenarios = {"kit": scenario_kit, "reference": scenario_reference, "kit-zero": scenario_kit_zero,
+                 "one-solved": scenario_one_solved, "compile-error": scenario_compile_error,
+                 "hidden": scenario_hidden, "no-isolation": scenario_no_isolation,
+                 "each-solved": scenario_each_solved}
+    for kind in HOSTILE:
+        scenarios[f"hostile-{kind}"] = lambda w, kind=kind: scenario_hostile(w, kind)
+    if scenario not in scenarios:
+        print(__doc__, file=sys.stderr)
+        return 2
+    if scenarios[scenario](work) == SKIPPED:
+        return SKIPPED
     print(f"{len(failures)} failed" if failures else "all checks passed")
     return 1 if failures else 0
 

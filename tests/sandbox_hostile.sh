@@ -44,6 +44,9 @@ expect "failed: exit 5" escape -- "$work/escape" "$outside"
 expect "failed: exit 5" escape-home -- "$work/escape" "$root/pwned.txt"
 expect "failed: exit 6" net -- "$work/net"
 expect "ok" inside -- "$work/escape" inside.txt
+expect "output limit" flood --output 1 -- yes flood
+# Even when the grader runs as root the sandbox has no capabilities: it cannot lift its limits.
+expect "failed: exit 4" lift -- sh -c 'prlimit --cpu=unlimited:unlimited --pid $$ || exit 4'
 [[ $(cat "$outside") == untouched ]] || { echo "FAIL: a file outside the sandbox changed"; failures=$((failures + 1)); }
 [[ ! -e $root/pwned.txt ]] || { echo "FAIL: wrote into the source tree"; rm -f "$root/pwned.txt"; failures=$((failures + 1)); }
 [[ $(cat "$work/box-inside/inside.txt") == pwned ]] || { echo "FAIL: the private folder is not writable"; failures=$((failures + 1)); }

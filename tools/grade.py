@@ -1,8 +1,9 @@
 #!/usr/bin/python3
 """Grades a student's tree against the workbook's reference tests.
 
-usage: tools/grade.py STUDENT_TREE [--hidden DIR] [--junit FILE] [--timeout S]
-                      [--steps 01,02] [--work DIR] [--jobs N]
+usage: tools/grade.py STUDENT_TREE [--hidden DIR] [--junit FILE] [--json FILE] [--timeout S]
+                      [--memory MB] [--output MB] [--build-timeout S] [--build-memory MB]
+                      [--steps 01,02] [--work DIR] [--jobs N] [--no-isolation]
        (./workbook grade ...)
 
 What the student owns: the C++ sources and headers in the step folders (steps/NN_name/*.cpp,
@@ -15,27 +16,39 @@ test program (test_stepNN) and its TEST_SUITE("exercise N.M") cases count for ex
 
 Each step's test program is built on its own, so a step that does not compile scores zero
 for its exercises (with the compiler's first error) and the other steps are still graded. Each
-test case of an "exercise N.M" suite runs as its own process with a time limit; an exercise
-earns its points (from the reference's markers) when it has test cases and all of them pass.
-The tests run under bubblewrap where it works (the files read-only but a private /tmp, no
-network) and write their results to a file, so what the student's code prints is not read.
-The points table goes to the terminal, a JUnit XML file to --junit (default WORK/grade.xml).
+test case of an "exercise N.M" suite runs as its own process; an exercise earns its points
+(from the reference's markers) when it has test cases and all of them pass.
+
+The student's code is untrusted: the configure, every build (the compilers read the
+student's sources) and every test case run in tools/sandbox.py's sandbox (bubblewrap: the
+system read-only, one writable folder: WORK/build for a build, a fresh folder per test
+case; a private /tmp, no network, no capabilities) with limits on wall-clock and CPU time,
+memory (address space) and output (--timeout, --memory, --output per test case;
+--build-timeout, --build-memory per step's build). Where bubblewrap cannot create
+namespaces the grader says so and refuses, unless --no-isolation. The tests write their
+results to a file, so what the student's code prints only counts against the output limit.
+A failing exercise says why: time limit, memory limit, output limit, crashed: SIGNAME,
+failed: <first failing assertion>, does not compile: <first error or the limit it hit>.
+The points table goes to the terminal, a JUnit XML file to --junit (default WORK/grade.xml;
+the reason is each failure's message), and with --json FILE the same results per exercise
+as JSON (exercise, title, step, points, max, status, reason, case, seconds).
 WORK/build is kept between runs, so grading the next tree rebuilds only what changed.
 """
 import argparse
+import json
 import os
 import re
 import shutil
-import signal
-import subprocess
 import sys
 import tempfile
 import time
 import xml.etree.ElementTree as ET
+from dataclasses import dataclass
 
 sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
 from exercises import SOURCE_SUFFIXES, case_results, exercises, step_dirs  # noqa: E402
 from kit import strip_solutions, tracked_files  # noqa: E402
+import sandbox  # noqa: E402
 
 ROOT = os.path.dirname(os.path.dirname(os.path.abspath(__file__)))
 
@@ -148,16 +161,62 @@ def assemble(student, hidden, work, steps):
 # Building and running ------------------------------------------------------------------------
 
 
-def configure(work):
+@dataclass
+class Isolation:
+    """How student code runs: isolated or not, and the limits of a build and of a test case."""
+    isolate: bool
+    build: sandbox.Limits
+    test: sandbox.Limits
+    jobs: int = 2
+    # What student code must not read: the reference tree (the solutions), the student's own
+    # tree, the instructor's hidden tests and home folders. It reads the grading tree instead
+    # (a build: WORK/src and WORK/build; a test: WORK/build and the data).
+    hidden: tuple = ()
+
+
+def clean_env(home):
+    """The environment student code sees: no secrets of the instructor's shell."""
+    env = {k: v for k, v in os.environ.items() if k in ("PATH", "LANG", "LC_ALL", "CC", "CXX", "TZ")}
+    env.setdefault("PATH", "/usr/local/bin:/usr/bin:/bin")
+    # glibc's malloc keeps up to 8 arenas of 64 MB address space per core: on a many-core
+    # machine that alone would pass the memory limit.
+    env.update(HOME=home, TMPDIR="/tmp", MALLOC_ARENA_MAX="2")
+    return env
+
+
+def build_reason(result, output, src):
+    """'does not compile: ...' for a failed build: a limit it hit (with the source being
+    compiled then), or the compiler's first error."""
+    if result.status in ("time limit", "memory limit", "output limit", "crashed"):
+        compiling = re.findall(r" -c (\S+\.(?:cpp|cc|cxx))\b", output)
+        where = f" (compiling {compiling[-1].replace(src + '/', '')})" if compiling else ""
+        if result.status == "time limit":
+            where += f" (the build ran over {result.seconds:.0f} s)"
+        elif result.status == "output limit":
+            error = first_error(output, src)
+            where += f": {error}" if error != "the build failed" else ""
+        return f"does not compile: {result.reason}{where}"
+    return f"does not compile: {first_error(output, src)}"
+
+
+def configure(work, iso):
+    """Configures the grading tree once (sandboxed like the builds: it reads the reference's
+    CMake files, but writes only WORK/build); exits with the reason when that fails."""
     build = os.path.join(work, "build")
-    if os.path.exists(os.path.join(build, "build.ninja")):
+    cache = os.path.join(build, "CMakeCache.txt")
+    if os.path.exists(os.path.join(build, "build.ninja")) and "BOXES_GRADING:BOOL=ON" in (
+            read(cache) if os.path.exists(cache) else ""):
         return
     say("configuring the grading tree (once; later grades reuse it)")
-    r = subprocess.run(["cmake", "-S", os.path.join(work, "src"), "-B", build, "-G", "Ninja",
-                        "-DCMAKE_BUILD_TYPE=Release"], capture_output=True, text=True)
-    if r.returncode != 0:
-        sys.stderr.write(r.stdout + r.stderr)
-        raise SystemExit("grade: configuring the grading tree failed (see above)")
+    os.makedirs(build, exist_ok=True)
+    # BOXES_GRADING: no ctest discovery, which would run the student's code in the build.
+    r = sandbox.run(["cmake", "-S", os.path.join(work, "src"), "-B", build, "-G", "Ninja",
+                     "-DCMAKE_BUILD_TYPE=Release", "-DBOXES_GRADING=ON"], iso.build, writable=[build],
+                    isolate=iso.isolate, env=clean_env(build), hidden=iso.hidden,
+                    readable=[os.path.join(work, "src")])
+    if not r.ok:
+        sys.stderr.write((r.stdout + r.stderr).decode(errors="replace"))
+        raise SystemExit(f"grade: configuring the grading tree failed ({r.reason}; see above)")
 
 
 def first_error(output, src):
@@ -173,66 +232,89 @@ def first_error(output, src):
     return "the build failed"
 
 
-def build_step(work, number, jobs):
-    """(ok, first error) for test_stepNN."""
-    r = subprocess.run(["cmake", "--build", os.path.join(work, "build"), "--target",
-                        f"test_step{number}", "--", f"-j{jobs}"], capture_output=True, text=True)
-    if r.returncode == 0:
-        return True, ""
+def build_step(work, number, iso):
+    """'' when test_stepNN builds, else the reason it does not ('does not compile: ...').
+    The compilers run on the student's sources, so the build is sandboxed: it writes only
+    WORK/build, within the build limits."""
+    build = os.path.join(work, "build")
+    r = sandbox.run(["cmake", "--build", build, "--target", f"test_step{number}", "--", f"-j{iso.jobs}"],
+                    iso.build, writable=[build], isolate=iso.isolate, env=clean_env(build),
+                    hidden=iso.hidden, readable=[os.path.join(work, "src")])
+    if r.ok:
+        return ""
+    output = (r.stdout + r.stderr).decode(errors="replace")
     with open(os.path.join(work, f"build-step{number}.log"), "w") as f:
-        f.write(r.stdout + r.stderr)
-    return False, first_error(r.stdout + r.stderr, os.path.join(work, "src"))
+        f.write(output + f"\n[grade] build result: {r.reason}\n")
+    return build_reason(r, output, os.path.join(work, "src"))
 
 
-def list_cases(binary, sandbox):
+def test_readable(binary):
+    """What a test program reads: its build tree (WORK/build) and the data (WORK/src/data)."""
+    build = os.path.dirname(os.path.dirname(binary))
+    return [build, os.path.join(os.path.dirname(build), "src", "data")]
+
+
+def list_cases(binary, iso, folder):
     """[(suite, test case)] of a test program, or raises RuntimeError saying why not."""
+    os.makedirs(folder, exist_ok=True)
+    limits = iso.test
+    r = sandbox.run([binary, "--list-test-cases", "--reporters=xml"], limits, writable=[folder],
+                    isolate=iso.isolate, env=clean_env(folder), keep=int(limits.output_mb * (1 << 20)),
+                    hidden=iso.hidden, readable=test_readable(binary))
     try:
-        r = subprocess.run(list(sandbox) + [binary, "--list-test-cases", "--reporters=xml"],
-                           capture_output=True, text=True, timeout=60)
-        root = ET.fromstring(r.stdout)
-    except (OSError, subprocess.TimeoutExpired, ET.ParseError) as e:
-        raise RuntimeError(f"the test program does not list its tests ({type(e).__name__})") from e
+        root = ET.fromstring(r.stdout.decode(errors="replace"))
+    except ET.ParseError as e:
+        # Before any test runs: the student's code in a global object's constructor, say.
+        status = r.status if r.status not in ("ok", "failed") else "failed"
+        reason = r.reason if status != "failed" else f"failed: {r.reason}"
+        raise RuntimeError(status, f"{reason} (the test program does not list its tests)") from e
     return [(c.get("testsuite", ""), c.get("name", "")) for c in root.iter("TestCase")]
 
 
-def sandbox_prefix(cwd, work):
-    """bubblewrap around the student's code where it works: the file system read-only but
-    for a private /tmp and the working folder, no network. [] when it is not available."""
-    bwrap = shutil.which("bwrap")
-    if not bwrap:
-        return []
-    prefix = [bwrap, "--ro-bind", "/", "/", "--dev", "/dev", "--proc", "/proc", "--tmpfs", "/tmp",
-              "--ro-bind", work, work, "--bind", cwd, cwd, "--unshare-net", "--unshare-pid", "--die-with-parent"]
-    try:
-        ok = subprocess.run(prefix + ["true"], capture_output=True, timeout=30).returncode == 0
-    except (OSError, subprocess.TimeoutExpired):
-        ok = False
-    return prefix if ok else []
+@dataclass
+class CaseOutcome:
+    name: str
+    status: str  # passed | failed | time limit | memory limit | output limit | crashed
+    reason: str  # "" when passed, else e.g. "crashed: SIGSEGV" or "failed: <assertion>"
+    seconds: float
+
+    @property
+    def passed(self):
+        return self.status == "passed"
 
 
-def run_case(binary, suite, name, timeout, cwd, sandbox=()):
-    """(passed, message) for one test case, in its own process with a time limit."""
-    # The results go to a file, not stdout, so what the student's code prints is not read.
-    result = os.path.join(cwd, f"result-{os.getpid()}-{time.monotonic_ns()}.xml")
-    cmd = list(sandbox) + [binary, f"--test-suite={suite}", f"--test-case={name}",
-                           "--reporters=xml", "--no-version", f"--out={result}"]
-    try:
-        p = subprocess.Popen(cmd, cwd=cwd, stdout=subprocess.DEVNULL, stderr=subprocess.PIPE,
-                             stdin=subprocess.DEVNULL, text=True, start_new_session=True)
-        _, err = p.communicate(timeout=timeout)
-    except subprocess.TimeoutExpired:
-        os.killpg(p.pid, signal.SIGKILL)
-        p.communicate()
-        return False, f"timed out after {timeout:g} s"
-    if p.returncode < 0:
-        return False, f"crashed ({signal.Signals(-p.returncode).name})"
-    results = [r for r in case_results(result) if r.name == name] if os.path.exists(result) else []
-    if os.path.exists(result):
-        os.remove(result)
-    if not results:
-        last = (err.strip().splitlines() or [""])[-1][:200]
-        return False, f"no result (exit code {p.returncode}) {last}".strip()
-    return results[0].passed, results[0].message
+def doctest_filter(name):
+    """doctest splits a filter at commas: a comma inside a name is escaped."""
+    return name.replace(",", "\\,")
+
+
+def run_case(binary, suite, name, iso, folder):
+    """One test case in its own sandboxed process, in a fresh writable folder, with the test
+    limits. doctest writes its results to a file there, so what the student's code prints is
+    only counted against the output limit, never read as a result."""
+    os.makedirs(folder)
+    result = os.path.join(folder, "result.xml")
+    cmd = [binary, "--test-suite=" + doctest_filter(suite), "--test-case=" + doctest_filter(name),
+           "--reporters=xml", "--no-version", f"--out={result}"]
+    r = sandbox.run(cmd, iso.test, writable=[folder], isolate=iso.isolate, env=clean_env(folder),
+                    keep=1 << 16, hidden=iso.hidden, readable=test_readable(binary))
+    found = [c for c in case_results(result) if c.name == name] if os.path.exists(result) else []
+    shutil.rmtree(folder, ignore_errors=True)
+    if r.status in ("time limit", "memory limit", "output limit", "crashed"):
+        return CaseOutcome(name, r.status, r.reason, r.seconds)
+    if found and found[0].passed and r.ok:
+        return CaseOutcome(name, "passed", "", r.seconds)
+    if found and not found[0].passed:
+        message = found[0].message
+        if "bad_alloc" in message:  # doctest caught the refused allocation
+            return CaseOutcome(name, "memory limit", "memory limit", r.seconds)
+        return CaseOutcome(name, "failed", f"failed: {message or 'the test case failed'}", r.seconds)
+    if found:  # passed, but the process then failed (at exit: the student's code still ran)
+        return CaseOutcome(name, "failed", f"failed: the test passed, then the program ended with "
+                           f"{r.reason}", r.seconds)
+    last = (r.stderr.decode(errors="replace").strip().splitlines() or [""])[-1][:200]
+    why = "no test result (it ended before doctest wrote one)" if r.ok else f"no test result, {r.reason[8:]}"
+    return CaseOutcome(name, "failed", f"failed: {why}" + (f": {last}" if last else ""), r.seconds)
 
 
 # The report ----------------------------------------------------------------------------------
@@ -242,7 +324,7 @@ def print_table(rows, notes, out=sys.stdout):
     total = sum(r["points"] for r in rows)
     earned = sum(r["points"] for r in rows if r["passed"])
     out.write(f"\nGrade: {earned} of {total} points\n\n")
-    out.write(f"{'exercise':<9} {'points':>6}  {'result':<7} first failure\n")
+    out.write(f"{'exercise':<9} {'points':>6}  {'result':<7} why it failed\n")
     for r in rows:
         got = r["points"] if r["passed"] else 0
         out.write(f"{r['id']:<9} {got:>2} / {r['points']:<2}  {'passed' if r['passed'] else 'FAILED':<7} "
@@ -285,6 +367,62 @@ def write_junit(path, rows, notes, seconds):
     ET.ElementTree(suites).write(path, encoding="utf-8", xml_declaration=True)
 
 
+def write_json(path, rows, notes, seconds):
+    """The per-exercise results as JSON, for batch grading and other tools: one object per
+    exercise with its points earned (0 unless passed), max, status (passed, failed, time
+    limit, memory limit, output limit, crashed, does not compile, no tests), reason (empty
+    when passed), the first failing test case and seconds."""
+    doc = {"points": sum(r["points"] for r in rows if r["passed"]),
+           "max": sum(r["points"] for r in rows), "seconds": round(seconds, 2),
+           "exercises": [{"exercise": r["id"], "title": r["title"], "step": r["step"],
+                          "points": r["points"] if r["passed"] else 0, "max": r["points"],
+                          "status": r["status"], "reason": r["reason"], "case": r["case"],
+                          "seconds": round(r["seconds"], 2)}
+                         for r in rows],
+           "notes": list(notes)}
+    os.makedirs(os.path.dirname(os.path.abspath(path)), exist_ok=True)
+    with open(path, "w", encoding="utf-8") as f:
+        json.dump(doc, f, indent=2)
+        f.write("\n")
+
+
+def exercise_row(e, number, build_error, outcomes, seconds):
+    """The report's row of one exercise: passed when it has test cases and all pass; else the
+    reason of its first failing case, of its step's build ('does not compile: ...'), or
+    (status, reason) of a test program that does not start."""
+    failed = [o for o in outcomes if not o.passed]
+    if isinstance(build_error, tuple):  # the test program does not start
+        (status, reason), case = build_error, ""
+    elif build_error:
+        status, reason, case = "does not compile", build_error, ""
+    elif not outcomes:
+        status, reason, case = "no tests", "no test cases for this exercise", ""
+    elif failed:
+        status, reason, case = failed[0].status, failed[0].reason, failed[0].name
+    else:
+        status, reason, case = "passed", "", ""
+    reason = reason if len(reason) <= 500 else reason[:497] + "..."
+    message = reason + (f' (test case "{case}")' if case else "")
+    details = [f"{'passed' if o.passed else 'FAILED'}: {o.name}" + ("" if o.passed else f": {o.reason}")
+               for o in outcomes] or [message]
+    return {"id": e.id, "title": e.title, "points": e.points, "step": number,
+            "passed": status == "passed", "status": status, "reason": reason, "case": case,
+            "message": message, "details": details,
+            "seconds": sum(o.seconds for o in outcomes) if outcomes else seconds}
+
+
+def refuse_without_isolation(args):
+    """The grader runs student code: without bubblewrap it refuses unless told otherwise."""
+    if args.no_isolation:
+        say("WARNING: student code runs WITHOUT isolation (--no-isolation): only for code you trust")
+        return
+    problem = sandbox.isolation_problem()
+    if problem:
+        print(f"grade: {problem}: refusing to run student code without isolation "
+              "(--no-isolation runs it unprotected, only for code you trust)", file=sys.stderr)
+        raise SystemExit(2)
+
+
 def grade(args):
     started = time.monotonic()
     student = os.path.abspath(args.student)
@@ -298,56 +436,49 @@ def grade(args):
     if unknown:
         raise SystemExit(f"grade: --steps {','.join(unknown)}: no such step with exercises "
                          f"(steps: {','.join(numbers)})")
-    notes = assemble(student, args.hidden and os.path.abspath(args.hidden), work, steps)
-    configure(work)
+    refuse_without_isolation(args)
+    hidden = args.hidden and os.path.abspath(args.hidden)
+    unreadable = (ROOT, student, hidden, os.path.expanduser("~"), "/home", "/root")
+    iso = Isolation(not args.no_isolation,
+                    build=sandbox.Limits(args.build_timeout, args.build_memory, args.output, file_mb=2048),
+                    test=sandbox.Limits(args.timeout, args.memory, args.output), jobs=args.jobs,
+                    hidden=tuple(dict.fromkeys(p for p in unreadable if p)))
+    notes = assemble(student, hidden, work, steps)
+    if not iso.isolate:
+        notes.append("student code ran without isolation (--no-isolation)")
+    configure(work, iso)
     rows = []
-    with tempfile.TemporaryDirectory(prefix="boxes-grade-") as cwd:
-        sandbox = [] if args.no_sandbox else sandbox_prefix(cwd, work)
-        if not sandbox:
-            notes.append("tests ran without a sandbox" + ("" if args.no_sandbox else
-                         " (bubblewrap is missing or cannot run here)"))
+    with tempfile.TemporaryDirectory(prefix="boxes-grade-") as scratch:
         for number in steps:
             items = [e for e in all_ex if f"{e.step:02d}" == number]
             say(f"step {number}: building test_step{number}")
             t0 = time.monotonic()
-            ok, error = build_step(work, number, args.jobs)
-            results = {e.id: [] for e in items}
-            if ok:
+            error = build_step(work, number, iso)
+            outcomes = {e.id: [] for e in items}
+            if not error:
                 binary = os.path.join(work, "build", "tests", f"test_step{number}")
                 try:
-                    cases = [(s, n) for s, n in list_cases(binary, sandbox) if s.startswith("exercise ")]
+                    cases = [(s, n) for s, n in list_cases(binary, iso, os.path.join(scratch, "list"))
+                             if s.startswith("exercise ")]
                 except RuntimeError as e:
-                    ok, error, cases = False, str(e), []
+                    error, cases = tuple(e.args), []
                 say(f"step {number}: running {len(cases)} test cases")
-                for suite, name in cases:
+                for i, (suite, name) in enumerate(cases):
                     ex = suite.split(" ", 1)[1]
-                    if ex not in results:
+                    if ex not in outcomes:
                         notes.append(f"suite '{suite}' has no exercise marker: not counted")
-                        results[ex] = []
-                    c0 = time.monotonic()
-                    passed, message = run_case(binary, suite, name, args.timeout, cwd, sandbox)
-                    results[ex].append((name, passed, message, time.monotonic() - c0))
+                        outcomes[ex] = []
+                    o = run_case(binary, suite, name, iso, os.path.join(scratch, f"{number}-{i}"))
+                    if not o.passed:
+                        say(f"step {number}: {name}: {o.reason}")
+                    outcomes[ex].append(o)
             for e in items:
-                cases = results[e.id]
-                failed = [c for c in cases if not c[1]]
-                if not ok:
-                    passed, message = False, f"step {number} does not build: {error}"
-                    if error.startswith("the test program"):
-                        message = f"step {number}: {error}"
-                elif not cases:
-                    passed, message = False, "no test cases for this exercise"
-                else:
-                    passed = not failed
-                    message = "" if passed else f"{failed[0][0]}: {failed[0][2]}"
-                details = [f"{'passed' if c[1] else 'FAILED'}: {c[0]}" + ("" if c[1] else f": {c[2]}")
-                           for c in cases] or [message]
-                seconds = sum(c[3] for c in cases) if cases else time.monotonic() - t0
-                rows.append({"id": e.id, "title": e.title, "points": e.points, "step": number,
-                             "passed": passed, "message": message, "details": details,
-                             "seconds": seconds})
+                rows.append(exercise_row(e, number, error, outcomes[e.id], time.monotonic() - t0))
     earned, total = print_table(rows, notes)
     junit = args.junit or os.path.join(work, "grade.xml")
     write_junit(junit, rows, notes, time.monotonic() - started)
+    if args.json:
+        write_json(args.json, rows, notes, time.monotonic() - started)
     say(f"{earned} of {total} points; JUnit XML: {junit}")
     return 0
 
@@ -359,15 +490,29 @@ def main(argv):
     p.add_argument("student", help="the student's workbook tree (a starter kit with their work)")
     p.add_argument("--hidden", help="folder of extra doctest files stepNN*.cpp")
     p.add_argument("--junit", help="JUnit XML file to write (default WORK/grade.xml)")
-    p.add_argument("--timeout", type=float, default=60.0, help="seconds per test case (default 60)")
+    p.add_argument("--json", help="also write the per-exercise results as JSON to this file")
+    p.add_argument("--timeout", type=float, default=60.0,
+                   help="time limit of one test case in seconds, wall clock (default 60)")
+    p.add_argument("--memory", type=int, default=2048,
+                   help="memory limit of a test process in MB, address space (default 2048)")
+    p.add_argument("--output", type=float, default=16.0,
+                   help="output limit in MB: what a test or a build prints, and any file a test "
+                        "writes (default 16)")
+    p.add_argument("--build-timeout", type=float, default=900.0,
+                   help="time limit of one step's build in seconds (default 900; the first "
+                        "build compiles the core too)")
+    p.add_argument("--build-memory", type=int, default=4096,
+                   help="memory limit of each compiler or linker process in MB (default 4096)")
     p.add_argument("--steps", help="grade only these steps, e.g. 01,03")
     p.add_argument("--work", help="where the grading tree and its build live (default build/grade)")
     p.add_argument("--jobs", type=int, default=2, help="parallel compile jobs (default 2)")
-    p.add_argument("--no-sandbox", action="store_true",
-                   help="run the tests without bubblewrap (read-only files, no network)")
+    p.add_argument("--no-isolation", "--no-sandbox", dest="no_isolation", action="store_true",
+                   help="build and run student code WITHOUT bubblewrap (the limits still hold); "
+                        "only for code you trust, where bubblewrap cannot run")
     args = p.parse_args(argv)
-    if args.timeout <= 0:
-        p.error("--timeout must be positive")
+    for flag in ("timeout", "memory", "output", "build_timeout", "build_memory", "jobs"):
+        if getattr(args, flag) <= 0:
+            p.error(f"--{flag.replace('_', '-')} must be positive")
     return grade(args)
 
 

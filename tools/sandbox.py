@@ -1,0 +1,266 @@
+#!/usr/bin/python3
+"""Runs one untrusted command isolated and limited: the grader's student builds and test
+runs (tools/grade.py imports this module), and tools/sandbox.sh on the command line.
+
+usage: tools/sandbox.py [--time S] [--memory MB] [--output MB] [--dir DIR]
+                        [--no-isolation] -- COMMAND [ARGS...]
+
+Isolation (bubblewrap): the whole system read-only, DIR (default: a fresh temporary folder)
+the only writable place and the working directory, a private /tmp of at most the output
+limit, no network (an own, empty network namespace), an own PID namespace, no capabilities
+and no further user namespaces (even when the grader runs as root), killed with its parent.
+Limits (setrlimit, inherited by every process the command starts): wall-clock seconds (the
+whole run), CPU seconds (per process: the wall time times the cores, so a busy loop in
+every thread still stops), address space per process, the size of any file written, and
+the bytes the command prints on stdout and stderr together.
+
+On the command line the command's stdout and stderr go to DIR/stdout.txt and
+DIR/stderr.txt (their first bytes, up to the output limit) and one line
+"sandbox: RESULT" goes to stdout: ok | failed: exit N | time limit | memory limit |
+output limit | crashed: SIGNAME. Exit status: 0 ok, 1 failed, 3 limit or crash, 2 usage
+or refused (bubblewrap cannot create namespaces here and no --no-isolation).
+Environment: BOXES_BWRAP names the bubblewrap program (default: bwrap on PATH).
+"""
+import argparse
+import os
+import resource
+import selectors
+import shutil
+import signal
+import subprocess
+import sys
+import tempfile
+import time
+from dataclasses import dataclass
+
+# What the C++ runtime, glibc, GCC and Python print when an allocation is refused: under an
+# address-space limit that is the normal way a memory hog ends.
+MEMORY_SIGNS = (b"std::bad_alloc", b"bad_alloc", b"Cannot allocate memory", b"out of memory",
+                b"virtual memory exhausted", b"MemoryError")
+
+
+@dataclass
+class Limits:
+    seconds: float = 10.0  # wall clock, the whole run
+    memory_mb: int = 1024  # address space of each process
+    output_mb: float = 16.0  # stdout + stderr together, and any one file written
+    file_mb: float = 0.0  # any one file written, when it must differ from output_mb (a build)
+
+    def cpu_seconds(self):
+        return int(self.seconds * (os.cpu_count() or 1)) + 1
+
+
+@dataclass
+class Result:
+    status: str  # ok | failed | time limit | memory limit | output limit | crashed
+    reason: str  # ok | failed: exit N | time limit | memory limit | output limit | crashed: SIGSEGV
+    returncode: int
+    stdout: bytes  # the first bytes (up to `keep`)
+    stderr: bytes
+    seconds: float
+
+    @property
+    def ok(self):
+        return self.status == "ok"
+
+
+def bwrap_program():
+    return os.environ.get("BOXES_BWRAP") or shutil.which("bwrap") or ""
+
+
+def isolation_problem():
+    """None when bubblewrap can isolate here, else one line saying why not."""
+    bwrap = bwrap_program()
+    if not bwrap:
+        return "bubblewrap is not installed (tools/deps.sh grade installs it)"
+    try:
+        r = subprocess.run([bwrap] + _namespaces() + ["--ro-bind", "/", "/", "true"],
+                           capture_output=True, text=True, timeout=30)
+    except (OSError, subprocess.TimeoutExpired) as e:
+        return f"bubblewrap ({bwrap}) does not run: {e}"
+    if r.returncode != 0:
+        first = (r.stderr.strip().splitlines() or [f"exit {r.returncode}"])[0]
+        return f"bubblewrap cannot create namespaces here ({first})"
+    return None
+
+
+def _namespaces():
+    # An own user namespace as "nobody" with no capabilities: root outside gets no power
+    # inside (no remounting the read-only system, no raising the limits).
+    return ["--unshare-all", "--unshare-user", "--uid", "65534", "--gid", "65534",
+            "--cap-drop", "ALL", "--disable-userns", "--die-with-parent", "--new-session"]
+
+
+def bwrap_prefix(writable, cwd, tmp_bytes, hidden=(), readable=()):
+    """bubblewrap arguments: the system read-only, `hidden` folders replaced by empty ones,
+    `readable` folders (inside hidden ones) shown again read-only, `writable` folders
+    read-write, a private /tmp of tmp_bytes, /dev and /proc of the sandbox's own."""
+    prefix = [bwrap_program(), "--ro-bind", "/", "/", "--dev", "/dev", "--proc", "/proc"]
+    covers = []
+    for d in hidden:
+        inside_another = any(d != h and d.startswith(h.rstrip("/") + "/") for h in list(hidden) + ["/tmp"])
+        if os.path.isdir(d) and d not in ("/", "/tmp") and not inside_another:
+            covers.append(d)
+            prefix += ["--tmpfs", d]
+    prefix += ["--size", str(int(tmp_bytes)), "--tmpfs", "/tmp"]
+    for d in readable:
+        if os.path.exists(d):
+            prefix += ["--ro-bind", d, d]
+    for d in writable:
+        prefix += ["--bind", d, d]
+    for d in covers:  # the empty covers stay read-only (after the binds made their mount points)
+        prefix += ["--remount-ro", d]
+    return prefix + ["--chdir", cwd] + _namespaces()
+
+
+def _set_limits(limits):
+    def apply():
+        cpu = limits.cpu_seconds()
+        file_bytes = int((limits.file_mb or limits.output_mb) * (1 << 20))
+        resource.setrlimit(resource.RLIMIT_CPU, (cpu, cpu + 1))  # SIGXCPU, then SIGKILL
+        resource.setrlimit(resource.RLIMIT_AS, (limits.memory_mb << 20,) * 2)
+        resource.setrlimit(resource.RLIMIT_FSIZE, (file_bytes,) * 2)  # SIGXFSZ past it
+        resource.setrlimit(resource.RLIMIT_CORE, (0, 0))
+    return apply
+
+
+def _signal_name(number):
+    try:
+        return signal.Signals(number).name
+    except ValueError:
+        return f"signal {number}"
+
+
+def run(cmd, limits, writable=(), cwd=None, isolate=True, keep=1 << 20, env=None, hidden=(),
+        readable=()):
+    """Runs cmd under the sandbox and limits; returns a Result. `writable`: the folders the
+    command may write (cwd, default the first of them, is one of them when isolated);
+    `hidden`: folders it must not read (they look empty), `readable`: folders inside those
+    it reads after all."""
+    writable = [os.path.abspath(d) for d in writable]
+    hidden = [os.path.abspath(d) for d in hidden]
+    readable = [os.path.abspath(d) for d in readable]
+    cwd = os.path.abspath(cwd or (writable[0] if writable else os.getcwd()))
+    output_bytes = int(limits.output_mb * (1 << 20))
+    full = list(cmd)
+    if isolate:
+        full = bwrap_prefix(writable or [cwd], cwd, output_bytes, hidden, readable) + ["--"] + full
+    started = time.monotonic()
+    try:
+        p = subprocess.Popen(full, cwd=cwd, stdin=subprocess.DEVNULL, stdout=subprocess.PIPE,
+                             stderr=subprocess.PIPE, start_new_session=True, env=env,
+                             preexec_fn=_set_limits(limits))
+    except OSError as e:
+        return Result("failed", f"failed: cannot start ({e.strerror})", 127, b"", str(e).encode(), 0.0)
+    out, err = bytearray(), bytearray()
+    printed, stopped = 0, ""
+    sel = selectors.DefaultSelector()
+    sel.register(p.stdout, selectors.EVENT_READ, out)
+    sel.register(p.stderr, selectors.EVENT_READ, err)
+    deadline = started + limits.seconds
+    open_pipes = 2
+    while open_pipes and not stopped:
+        left = deadline - time.monotonic()
+        if left <= 0:
+            stopped = "time limit"
+            break
+        for key, _ in sel.select(timeout=min(left, 1.0)):
+            chunk = os.read(key.fd, 1 << 16)
+            if not chunk:
+                sel.unregister(key.fileobj)
+                open_pipes -= 1
+                continue
+            printed += len(chunk)
+            buf = key.data
+            if len(buf) < keep:
+                buf += chunk[: keep - len(buf)]
+            if printed > output_bytes:
+                stopped = "output limit"
+                break
+    if not stopped:
+        try:
+            p.wait(timeout=max(0.0, deadline - time.monotonic()))
+        except subprocess.TimeoutExpired:
+            stopped = "time limit"
+    if stopped:
+        _kill(p)
+    sel.close()
+    p.stdout.close()
+    p.stderr.close()
+    seconds = time.monotonic() - started
+    return _classify(p.returncode, stopped, isolate, bytes(out), bytes(err), seconds)
+
+
+def _kill(p):
+    try:
+        os.killpg(p.pid, signal.SIGKILL)  # bwrap and, through --die-with-parent, the sandbox
+    except ProcessLookupError:
+        pass
+    try:
+        p.wait(timeout=10)
+    except subprocess.TimeoutExpired:
+        p.kill()
+        p.wait()
+
+
+def _classify(code, stopped, isolate, out, err, seconds):
+    def result(status, reason):
+        return Result(status, reason, code, out, err, seconds)
+
+    if stopped:
+        return result(stopped, stopped)
+    if code == 0:
+        return result("ok", "ok")
+    # Killed by a signal: Popen says -N; bubblewrap passes its child's death on as 128 + N.
+    signum = -code if code < 0 else (code - 128 if isolate and 128 < code < 160 else 0)
+    if any(sign in out[-4096:] + err for sign in MEMORY_SIGNS):
+        return result("memory limit", "memory limit")
+    if signum == signal.SIGXCPU:
+        return result("time limit", "time limit")
+    if signum == signal.SIGXFSZ:
+        return result("output limit", "output limit")
+    if signum:
+        return result("crashed", f"crashed: {_signal_name(signum)}")
+    return result("failed", f"failed: exit {code}")
+
+
+def main(argv):
+    p = argparse.ArgumentParser(prog="tools/sandbox.sh", description=__doc__.split("\n\n")[0],
+                                epilog="\n\n".join(__doc__.split("\n\n")[2:]),
+                                formatter_class=argparse.RawDescriptionHelpFormatter)
+    p.add_argument("--time", type=float, default=10.0, help="wall-clock seconds (default 10)")
+    p.add_argument("--memory", type=int, default=1024, help="address space in MB per process (default 1024)")
+    p.add_argument("--output", type=float, default=16.0, help="MB printed, and per file written (default 16)")
+    p.add_argument("--dir", help="the writable working folder (default: a new temporary one)")
+    p.add_argument("--no-isolation", action="store_true", help="limits only, no bubblewrap (trusted code)")
+    p.add_argument("command", nargs=argparse.REMAINDER)
+    args = p.parse_args(argv)
+    cmd = args.command[1:] if args.command[:1] == ["--"] else args.command
+    if not cmd:
+        p.print_usage(sys.stderr)
+        print("sandbox: no command given", file=sys.stderr)
+        return 2
+    if args.time <= 0 or args.memory <= 0 or args.output <= 0:
+        print("sandbox: --time, --memory and --output must be positive", file=sys.stderr)
+        return 2
+    if args.no_isolation:
+        print("sandbox: WARNING: running without isolation (--no-isolation)", file=sys.stderr)
+    else:
+        problem = isolation_problem()
+        if problem:
+            print(f"sandbox: {problem}; refusing to run untrusted code without isolation "
+                  "(--no-isolation to force)", file=sys.stderr)
+            return 2
+    folder = args.dir or tempfile.mkdtemp(prefix="boxes-sandbox-")
+    os.makedirs(folder, exist_ok=True)
+    r = run(cmd, Limits(args.time, args.memory, args.output), writable=[folder],
+            isolate=not args.no_isolation, keep=int(args.output * (1 << 20)))
+    for name, data in (("stdout.txt", r.stdout), ("stderr.txt", r.stderr)):
+        with open(os.path.join(folder, name), "wb") as f:
+            f.write(data)
+    print(f"sandbox: {r.reason}", flush=True)
+    return {"ok": 0, "failed": 1}.get(r.status, 3)
+
+
+if __name__ == "__main__":
+    sys.exit(main(sys.argv[1:]))

@@ -40,7 +40,9 @@ int runTrace(const TraceOptions& o) {
     build.builder = parseBvhBuilder(o.builder);
     build.bins = o.bins;
     BvhBuildStats stats;
+    double buildCpuStart = processCpuSeconds();
     Bvh bvh = buildBvh(mesh, build, &stats);
+    double buildCpuSeconds = processCpuSeconds() - buildCpuStart;
     std::vector<TraceHit> hits;
     std::vector<double> seconds, cpuSeconds;
     for (int i = 0; i < o.repeat; ++i) {
@@ -57,6 +59,7 @@ int runTrace(const TraceOptions& o) {
     nlohmann::json j = {{"tris", mesh.triangleCount()},
                         {"rays", rays.size()},
                         {"build_ms", stats.buildMs},
+                        {"build_cpu_ms", buildCpuSeconds * 1e3},
                         {"trace_ms", traceSeconds * 1e3},
                         {"trace_cpu_ms", summarize(cpuSeconds).median * 1e3},
                         {"mrays_per_s", double(rays.size()) / traceSeconds / 1e6},

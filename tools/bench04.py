@@ -169,7 +169,14 @@ def main():
     print("\n(load average during the run: %.1f on %d cores; ratios are back to back, the "
           "absolute figures drift with the load)" % (load, os.cpu_count()))
     os.makedirs(os.path.dirname(os.path.abspath(a.out)), exist_ok=True)
-    report = {"program": "04_bvh_bench", "images": [], "facts": {"load_average": os.getloadavg()[0]}, "rays": a.rays, "repeat": a.repeat, "load_average": load,
+    cpu = "unknown CPU"
+    try:
+        cpu = [l.split(":", 1)[1].strip() for l in open("/proc/cpuinfo")
+               if l.startswith("model name")][0]
+    except (OSError, IndexError):
+        pass
+    report = {"program": "04_bvh_bench", "images": [],
+              "machine": "%s, %d cores, load average %.1f" % (cpu, os.cpu_count(), load), "facts": {"load_average": os.getloadavg()[0]}, "rays": a.rays, "repeat": a.repeat, "load_average": load,
               "tables": [
                   {"id": "bench04_embree", "title": "Step 04 beside Embree 3: one thread each",
                    "columns": ["mesh", "rays", "builder", "Mrays/s", "Embree Mrays/s", "ratio",

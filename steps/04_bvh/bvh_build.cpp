@@ -85,33 +85,44 @@ size_t partitionBinnedSah(std::span<BuildPrimitive> prims, const Bounds3f& nodeB
     // A node without area (all primitives on one line) gives no guidance: no split.
     if (!(nodeArea > 0.0f)) return 0;
     int bestAxis = -1, bestPlane = 0;
-    float bestScale = 0.0f;
+    // Per axis: the bin scale (0 for an axis with zero extent: nothing to split there, and
+    // a division by zero otherwise). All three axes are binned in one pass over the
+    // primitives: the build reads each primitive once per level, not three times.
     Vec3 extent = centroidBounds.diagonal();
+    float scale[3], lowest[3];
     for (int axis = 0; axis < 3; ++axis) {
-        // A zero extent has nothing to split (and would divide by zero below).
         float axisExtent = component(extent, axis);
-        if (!(axisExtent > 0.0f)) continue;
-        float scale = float(bins) / axisExtent;
-        if (!std::isfinite(scale) || !(scale > 0.0f)) continue;
-        float lowest = component(centroidBounds.min, axis);
-        SahBin bin[kMaxBins];
+        float s = axisExtent > 0.0f ? float(bins) / axisExtent : 0.0f;
+        scale[axis] = std::isfinite(s) ? s : 0.0f;
+        lowest[axis] = component(centroidBounds.min, axis);
+    }
+    if (scale[0] == 0.0f && scale[1] == 0.0f && scale[2] == 0.0f) return 0;
+    SahBin bin[3][kMaxBins];
+    for (int axis = 0; axis < 3; ++axis)
         for (int b = 0; b < bins; ++b)
-            bin[b] = {Vec3(kInfinity<float>), Vec3(-kInfinity<float>), 0};
-        for (const BuildPrimitive& p : prims) {
-            int b = std::min(bins - 1, int((component(p.centroid, axis) - lowest) * scale));
-            bin[b].count++;
-            bin[b].lo = glm::min(bin[b].lo, p.bounds.min);
-            bin[b].hi = glm::max(bin[b].hi, p.bounds.max);
+            bin[axis][b] = {Vec3(kInfinity<float>), Vec3(-kInfinity<float>), 0};
+    for (const BuildPrimitive& p : prims) {
+        for (int axis = 0; axis < 3; ++axis) {
+            int b =
+                std::min(bins - 1, int((component(p.centroid, axis) - lowest[axis]) * scale[axis]));
+            SahBin& into = bin[axis][b];
+            into.count++;
+            into.lo = glm::min(into.lo, p.bounds.min);
+            into.hi = glm::max(into.hi, p.bounds.max);
         }
+    }
+    for (int axis = 0; axis < 3; ++axis) {
+        if (scale[axis] == 0.0f) continue;
+        const SahBin* axisBins = bin[axis];
         // Sweep from the right: area and count right of each plane; then from the left.
         float rightArea[kMaxBins];
         uint32_t rightCount[kMaxBins];
         Vec3 lo(kInfinity<float>), hi(-kInfinity<float>);
         uint32_t count = 0;
         for (int plane = bins - 1; plane > 0; --plane) {
-            count += bin[plane].count;
-            lo = glm::min(lo, bin[plane].lo);
-            hi = glm::max(hi, bin[plane].hi);
+            count += axisBins[plane].count;
+            lo = glm::min(lo, axisBins[plane].lo);
+            hi = glm::max(hi, axisBins[plane].hi);
             rightArea[plane] = count ? area(lo, hi) : 0.0f;
             rightCount[plane] = count;
         }
@@ -119,9 +130,9 @@ size_t partitionBinnedSah(std::span<BuildPrimitive> prims, const Bounds3f& nodeB
         hi = Vec3(-kInfinity<float>);
         count = 0;
         for (int plane = 1; plane < bins; ++plane) {
-            count += bin[plane - 1].count;
-            lo = glm::min(lo, bin[plane - 1].lo);
-            hi = glm::max(hi, bin[plane - 1].hi);
+            count += axisBins[plane - 1].count;
+            lo = glm::min(lo, axisBins[plane - 1].lo);
+            hi = glm::max(hi, axisBins[plane - 1].hi);
             if (count == 0 || rightCount[plane] == 0) continue;
             float c = options.traversalCost + options.intersectionCost *
                                                   (area(lo, hi) * float(count) +
@@ -131,15 +142,14 @@ size_t partitionBinnedSah(std::span<BuildPrimitive> prims, const Bounds3f& nodeB
                 cost = c;
                 bestAxis = axis;
                 bestPlane = plane;
-                bestScale = scale;
             }
         }
     }
     if (bestAxis < 0) return 0;
     // Partition with the same bin arithmetic, so every primitive lands where it was counted.
-    float lowest = component(centroidBounds.min, bestAxis);
+    float axisLowest = lowest[bestAxis], axisScale = scale[bestAxis];
     auto middle = std::partition(prims.begin(), prims.end(), [&](const BuildPrimitive& p) {
-        int b = std::min(bins - 1, int((component(p.centroid, bestAxis) - lowest) * bestScale));
+        int b = std::min(bins - 1, int((component(p.centroid, bestAxis) - axisLowest) * axisScale));
         return b < bestPlane;
     });
     return size_t(middle - prims.begin());
@@ -194,7 +204,7 @@ size_t partitionSweepSah(std::span<BuildPrimitive> prims, const Bounds3f& nodeBo
 namespace {
 
 class BvhBuildJob {
-  public:
+public:
     BvhBuildJob(std::vector<BuildPrimitive>& prims, const BvhBuildOptions& options, Bvh& bvh)
         : prims_(prims), options_(options), bvh_(bvh) {}
 
@@ -206,7 +216,7 @@ class BvhBuildJob {
         buildNode(0, 0, prims_.size(), 0);
     }
 
-  private:
+private:
     bool isSah() const {
         return options_.builder == BvhBuilder::BinnedSah ||
                options_.builder == BvhBuilder::SweepSah;

@@ -5,6 +5,7 @@
 #include <imgui.h>
 
 #include <cstdio>
+#include <ctime>
 #include <iostream>
 #include <nlohmann/json.hpp>
 
@@ -17,6 +18,14 @@
 using namespace boxes;
 
 namespace {
+
+// CPU time of the process (all threads): on a loaded machine the wall time includes the
+// time other processes held the core; the CPU time of one thread does not.
+double processCpuSeconds() {
+    timespec ts{};
+    clock_gettime(CLOCK_PROCESS_CPUTIME_ID, &ts);
+    return double(ts.tv_sec) + 1e-9 * double(ts.tv_nsec);
+}
 
 struct TraceOptions {
     std::string mesh, rays, hits, builder = "sah";
@@ -31,13 +40,17 @@ int runTrace(const TraceOptions& o) {
     build.builder = parseBvhBuilder(o.builder);
     build.bins = o.bins;
     BvhBuildStats stats;
+    double buildCpuStart = processCpuSeconds();
     Bvh bvh = buildBvh(mesh, build, &stats);
+    double buildCpuSeconds = processCpuSeconds() - buildCpuStart;
     std::vector<TraceHit> hits;
-    std::vector<double> seconds;
+    std::vector<double> seconds, cpuSeconds;
     for (int i = 0; i < o.repeat; ++i) {
         Stopwatch watch;
+        double cpuStart = processCpuSeconds();
         traceBatch(bvh, rays, hits, o.threads);
         seconds.push_back(watch.seconds());
+        cpuSeconds.push_back(processCpuSeconds() - cpuStart);
     }
     double traceSeconds = summarize(seconds).median;
     size_t hitCount = 0;
@@ -46,7 +59,9 @@ int runTrace(const TraceOptions& o) {
     nlohmann::json j = {{"tris", mesh.triangleCount()},
                         {"rays", rays.size()},
                         {"build_ms", stats.buildMs},
+                        {"build_cpu_ms", buildCpuSeconds * 1e3},
                         {"trace_ms", traceSeconds * 1e3},
+                        {"trace_cpu_ms", summarize(cpuSeconds).median * 1e3},
                         {"mrays_per_s", double(rays.size()) / traceSeconds / 1e6},
                         {"hits", hitCount},
                         {"threads", o.threads},

@@ -36,15 +36,48 @@ struct WatertightRay {
     }
 };
 
+// The six axis orders (kz the dominant axis, kx and ky swapped for a negative d[kz]),
+// as compile-time constants: the leaf test then reads components from registers instead
+// of through a run-time index (a store and an indexed load per component), and the
+// traversal is instantiated once per order, chosen once per ray (withWatertightAxes).
+template <int Kz, bool Swap>
+struct WatertightAxes {
+    static constexpr int kz = Kz;
+    static constexpr int kx = Swap ? (Kz + 2) % 3 : (Kz + 1) % 3;
+    static constexpr int ky = Swap ? (Kz + 1) % 3 : (Kz + 2) % 3;
+};
+
+// Calls f(WatertightAxes<...>{}) with the ray's axis order.
+template <typename F>
+decltype(auto) withWatertightAxes(const WatertightRay& r, F&& f) {
+    bool swap = r.kx != (r.kz + 1) % 3;
+    switch (r.kz * 2 + int(swap)) {
+        case 0:
+            return f(WatertightAxes<0, false>{});
+        case 1:
+            return f(WatertightAxes<0, true>{});
+        case 2:
+            return f(WatertightAxes<1, false>{});
+        case 3:
+            return f(WatertightAxes<1, true>{});
+        case 4:
+            return f(WatertightAxes<2, false>{});
+        default:
+            return f(WatertightAxes<2, true>{});
+    }
+}
+
 // A hit in [ray.tmin, tmax] lowers tmax to it; (u, v) are the barycentrics of b and c.
-// Components are read through pointers: glm's operator[] is a switch, too slow here.
-inline bool intersectLeafTriangle(const WatertightRay& r, const LeafTriangle& tri, float& tmax,
-                                  float* uOut = nullptr, float* vOut = nullptr) {
+// Axes must be the ray's order (r.kx, r.ky, r.kz); the arithmetic is exercise 1.5's.
+template <typename Axes>
+inline bool intersectLeafTriangle(Axes, const WatertightRay& r, const LeafTriangle& tri,
+                                  float& tmax, float* uOut = nullptr, float* vOut = nullptr) {
+    constexpr int kx = Axes::kx, ky = Axes::ky, kz = Axes::kz;
     const Vec3 av = tri.a - r.origin, bv = tri.b - r.origin, cv = tri.c - r.origin;
     const float *a = &av.x, *b = &bv.x, *c = &cv.x;
-    float ax = a[r.kx] - r.sx * a[r.kz], ay = a[r.ky] - r.sy * a[r.kz];
-    float bx = b[r.kx] - r.sx * b[r.kz], by = b[r.ky] - r.sy * b[r.kz];
-    float cx = c[r.kx] - r.sx * c[r.kz], cy = c[r.ky] - r.sy * c[r.kz];
+    float ax = a[kx] - r.sx * a[kz], ay = a[ky] - r.sy * a[kz];
+    float bx = b[kx] - r.sx * b[kz], by = b[ky] - r.sy * b[kz];
+    float cx = c[kx] - r.sx * c[kz], cy = c[ky] - r.sy * c[kz];
     float u = cx * by - cy * bx;
     float v = ax * cy - ay * cx;
     float w = bx * ay - by * ax;
@@ -57,13 +90,20 @@ inline bool intersectLeafTriangle(const WatertightRay& r, const LeafTriangle& tr
     if ((u < 0.0f || v < 0.0f || w < 0.0f) && (u > 0.0f || v > 0.0f || w > 0.0f)) return false;
     float det = u + v + w;
     if (det == 0.0f || !std::isfinite(det)) return false;
-    float az = r.sz * a[r.kz], bz = r.sz * b[r.kz], cz = r.sz * c[r.kz];
+    float az = r.sz * a[kz], bz = r.sz * b[kz], cz = r.sz * c[kz];
     float t = (u * az + v * bz + w * cz) / det;
     if (!(t >= r.tmin && t <= tmax)) return false;
     tmax = t;
     if (uOut) *uOut = v / det;
     if (vOut) *vOut = w / det;
     return true;
+}
+
+// The same with the axis order chosen at run time (one switch per call: not for loops).
+inline bool intersectLeafTriangle(const WatertightRay& r, const LeafTriangle& tri, float& tmax,
+                                  float* uOut = nullptr, float* vOut = nullptr) {
+    return withWatertightAxes(
+        r, [&](auto axes) { return intersectLeafTriangle(axes, r, tri, tmax, uOut, vOut); });
 }
 
 // The nearest hit of one ray: t (+infinity on a miss) and the triangle in file order.
@@ -79,8 +119,10 @@ inline TraceHit traceNearest(const Bvh& bvh, const Ray& ray) {
     WatertightRay watertight(ray);
     float tClosest = ray.tmax;
     const LeafTriangle* tris = bvh.leafTriangles.data();
-    uint32_t slot = traverseNearest(bvh, traversal, tClosest, [&](uint32_t s, float& tmax) {
-        return intersectLeafTriangle(watertight, tris[s], tmax);
+    uint32_t slot = withWatertightAxes(watertight, [&](auto axes) {
+        return traverseNearest(bvh, traversal, tClosest, [&](uint32_t s, float& tmax) {
+            return intersectLeafTriangle(axes, watertight, tris[s], tmax);
+        });
     });
     if (slot == kTraversalMiss) return {};
     return {tClosest, bvh.primitiveIndices[slot]};
@@ -90,8 +132,10 @@ inline bool traceOccluded(const Bvh& bvh, const Ray& ray) {
     TraversalRay traversal(ray, bvh);
     WatertightRay watertight(ray);
     const LeafTriangle* tris = bvh.leafTriangles.data();
-    return traverseAny(bvh, traversal, [&](uint32_t s, float tmax) {
-        return intersectLeafTriangle(watertight, tris[s], tmax);
+    return withWatertightAxes(watertight, [&](auto axes) {
+        return traverseAny(bvh, traversal, [&](uint32_t s, float tmax) {
+            return intersectLeafTriangle(axes, watertight, tris[s], tmax);
+        });
     });
 }
 
@@ -137,7 +181,7 @@ std::vector<Ray> makeRays(const Mesh& mesh, RayKind kind, size_t count, uint64_t
 
 // The mesh as renderer geometry, through the hierarchy.
 class MeshBvhGeometry : public Geometry {
-  public:
+public:
     MeshBvhGeometry(const Mesh& mesh, int material, const BvhBuildOptions& options);
     bool intersect(const Ray& ray, SurfaceHit& hit) const override;
     bool occluded(const Ray& ray) const override;
@@ -147,7 +191,7 @@ class MeshBvhGeometry : public Geometry {
     const Bvh& bvh() const { return bvh_; }
     const BvhBuildStats& stats() const { return stats_; }
 
-  private:
+private:
     const Mesh& mesh_;
     int material_;
     BvhBuildStats stats_;  // before bvh_: the build fills it

@@ -246,6 +246,13 @@ def scenario_classroom(work):
                            + no_isolation(),
                            capture_output=True, text=True)
         check(r.returncode == 0, f"{label}: graded into the shared grading build")
+        # The grader configures its tree without ctest discovery (BOXES_GRADING); the kit's
+        # workflow runs ctest in an ordinary build, so turn discovery back on for this step.
+        build = os.path.join(w0, "build")
+        c = subprocess.run(f"cmake -S {w0}/src -B {build} -DBOXES_GRADING=OFF >/dev/null && "
+                           f"cmake --build {build} --target test_step{step} >/dev/null",
+                           shell=True, capture_output=True, text=True)
+        check(c.returncode == 0, f"{label}: the step's tests discovered for ctest ({c.stderr.strip()[-300:]})")
         for e in [e for e in all_ex if f"{e.step:02d}" == step]:
             cmd = exercise_command(e.id, os.path.join(w0, "build"))
             c = subprocess.run(cmd, shell=True, capture_output=True, text=True)

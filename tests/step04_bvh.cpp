@@ -504,7 +504,7 @@ TEST_SUITE("exercise 4.6") {
 }
 
 TEST_SUITE("exercise 4.7") {
-    TEST_CASE("p-vertex: outside one plane culled, straddling and inside kept") {
+    TEST_CASE("p-vertex: outside one plane culled while straddling and inside kept") {
         Frustum f = handFrustum();
         CHECK(cullByPlanes(f, {Vec3(-1, -1, 1), Vec3(1, 1, 3)}));        // behind the eye
         CHECK(cullByPlanes(f, {Vec3(-1, -1, -300), Vec3(1, 1, -200)}));  // beyond far

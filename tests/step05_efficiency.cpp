@@ -610,7 +610,7 @@ TEST_SUITE("renderer 05") {
             if (m == PreviewMode::Full) CHECK(bitIdentical(img, full));
         }
     }
-    TEST_CASE("schedules: static rows, dynamic rows and tiles give the same image") {
+    TEST_CASE("schedules: static rows and dynamic rows and tiles give the same image") {
         Scene scene = makeScene("spheres", {});
         RenderSettings s;
         s.width = 50;

@@ -27,6 +27,9 @@ struct Token {
 };
 
 std::vector<Token> tokenize(const std::string& s) {
+    if (s.size() > kMaxAnswerLength)
+        throw std::invalid_argument("the answer is longer than " +
+                                    std::to_string(kMaxAnswerLength) + " characters");
     std::vector<Token> tokens;
     size_t i = 0;
     while (i < s.size()) {
@@ -72,7 +75,7 @@ std::vector<Token> tokenize(const std::string& s) {
 
 // Recursive descent over the tokens; `list` makes whitespace and signs separate numbers.
 class Parser {
-  public:
+public:
     Parser(std::vector<Token> tokens, bool list) : tokens_(std::move(tokens)), list_(list) {}
 
     std::vector<double> parseList() {
@@ -95,7 +98,7 @@ class Parser {
         return v;
     }
 
-  private:
+private:
     const Token& peek() const { return tokens_[pos_]; }
     bool isSymbol(const char* s) const { return peek().kind == Token::Symbol && peek().text == s; }
     // In a list at the outer level, " -2" (space before, none after) starts a new number.
@@ -130,7 +133,18 @@ class Parser {
         }
     }
 
+    // Counts the levels of recursion: deeper answers are refused, not a stack overflow.
+    struct Nesting {
+        int& depth;
+        explicit Nesting(int& d) : depth(d) {
+            if (++depth > kMaxAnswerNesting)
+                throw std::invalid_argument("the answer is nested too deeply");
+        }
+        ~Nesting() { --depth; }
+    };
+
     double unary() {
+        Nesting nesting(nesting_);
         if (isSymbol("-")) {
             ++pos_;
             return -unary();
@@ -152,6 +166,7 @@ class Parser {
     }
 
     double primary() {
+        Nesting nesting(nesting_);
         const Token t = peek();
         if (t.kind == Token::Number) {
             ++pos_;
@@ -185,6 +200,7 @@ class Parser {
     bool list_;
     size_t pos_ = 0;
     int depth_ = 0;
+    int nesting_ = 0;
 };
 
 // "(...)" or "[...]" around the whole text is dropped: "(1, 2, 3)" is the list 1, 2, 3.

@@ -107,10 +107,16 @@ struct RayRecord {
 };
 static_assert(sizeof(RayRecord) == 32, "the RAYS.bin record");
 
-// Reads and checks a rays file: size a multiple of 32 bytes, finite origins and
-// directions, non-zero directions, no NaN in tmin/tmax. Throws InputError naming the
-// file and the first bad ray.
+// Reads and checks a rays file: size a multiple of 32 bytes, at most kMaxRays rays (a
+// larger file is refused before anything is read), finite origins and directions,
+// non-zero directions, no NaN in tmin/tmax. tmin and tmax may be infinite, and
+// tmin > tmax is an empty interval: that ray misses. Throws InputError naming the file
+// and the first bad ray.
+constexpr size_t kMaxRays = size_t(1) << 25;  // 1 GiB of records
 std::vector<Ray> readRays(const std::string& path);
+// The same checks on the bytes of a rays file in memory; `name` starts the messages
+// ("rays file 'r.bin'").
+std::vector<Ray> parseRays(const void* data, size_t size, const std::string& name);
 void writeRays(const std::string& path, const std::vector<Ray>& rays);
 // HITS.bin: float32 t, uint32 triangle per ray; written atomically (temp file + rename).
 void writeHits(const std::string& path, const std::vector<TraceHit>& hits);
@@ -137,7 +143,7 @@ std::vector<Ray> makeRays(const Mesh& mesh, RayKind kind, size_t count, uint64_t
 
 // The mesh as renderer geometry, through the hierarchy.
 class MeshBvhGeometry : public Geometry {
-  public:
+public:
     MeshBvhGeometry(const Mesh& mesh, int material, const BvhBuildOptions& options);
     bool intersect(const Ray& ray, SurfaceHit& hit) const override;
     bool occluded(const Ray& ray) const override;
@@ -147,7 +153,7 @@ class MeshBvhGeometry : public Geometry {
     const Bvh& bvh() const { return bvh_; }
     const BvhBuildStats& stats() const { return stats_; }
 
-  private:
+private:
     const Mesh& mesh_;
     int material_;
     BvhBuildStats stats_;  // before bvh_: the build fills it

@@ -65,6 +65,10 @@ std::vector<Ray> parseRays(const void* data, size_t size, const std::string& nam
         if (!isFinite(o) || !isFinite(d))
             throw InputError(where() + "infinite origin or direction");
         if (isZero(d)) throw InputError(where() + "zero direction");
+        // Distances along a direction this short overflow float (issue 10's fuzzing: a
+        // subnormal direction gave a "hit" at t = -infinity).
+        if (maxComponent(glm::abs(d)) < kMinRayDirection)
+            throw InputError(where() + "direction too short (largest component below 2^-32)");
         rays.emplace_back(o, d, r.tmin, r.tmax);
     }
     return rays;

@@ -211,6 +211,9 @@ def replay(paths):
 
 
 def fuzz(seconds, artifacts):
+    # Hypothesis keeps a cache (unicode data) in .hypothesis/ of the current folder: not
+    # in the source tree.
+    os.environ.setdefault("HYPOTHESIS_STORAGE_DIRECTORY", os.path.join(ROOT, "build", "fuzz", "hypothesis"))
     from hypothesis import HealthCheck, given, settings
     from hypothesis import strategies as st
 

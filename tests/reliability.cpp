@@ -341,6 +341,10 @@ TEST_SUITE("hard cases reliability") {
               "rays file 'r.bin': ray 0: infinite origin or direction");
         CHECK(rayRefusal({0, 0, 0, 0, 0, -0.0f, 0, 1}) ==
               "rays file 'r.bin': ray 0: zero direction");
+        // A subnormal direction made a hit at t = -infinity (found by fuzzing).
+        CHECK(rayRefusal({0.3f, 0.2f, 5, -inf, 0, 5.9e-39f, 2.3e-38f, 0}) ==
+              "rays file 'r.bin': ray 0: direction too short (largest component below 2^-32)");
+        CHECK(rayRefusal({0, 0, 0, 0, 0, 0, 0x1p-32f, 1}) == "(accepted)");
         CHECK(rayRefusal({0, 0, 0, 0, 0, 0}) ==
               "rays file 'r.bin': size 24 bytes is not a multiple of 32 (8 float32 per ray)");
         // tmin > tmax is an empty interval: read, and a miss.

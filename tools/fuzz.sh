@@ -26,6 +26,7 @@ for t in "${targets[@]}"; do
   [[ $t == results || -x $bin ]] || { echo "fuzz.sh: no target '$t'" >&2; exit 2; }
   work=build/fuzz/work/$t
   artifacts=build/fuzz/artifacts/$t
+  rm -rf "$artifacts"  # what earlier runs found is in the corpus already
   mkdir -p "$work" "$artifacts"
   echo "== fuzz_$t for $seconds s (log: build/fuzz/$t.log)"
   status=0

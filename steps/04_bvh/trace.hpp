@@ -109,9 +109,9 @@ static_assert(sizeof(RayRecord) == 32, "the RAYS.bin record");
 
 // Reads and checks a rays file: size a multiple of 32 bytes, at most kMaxRays rays (a
 // larger file is refused before anything is read), finite origins and directions, each
-// direction's largest component at least kMinRayDirection, no NaN in tmin/tmax. tmin and tmax may be infinite, and
-// tmin > tmax is an empty interval: that ray misses. Throws InputError naming the file
-// and the first bad ray.
+// direction's largest component at least kMinRayDirection, no NaN in tmin/tmax. tmin
+// and tmax may be infinite, and tmin > tmax is an empty interval: that ray misses. Throws
+// InputError naming the file and the first bad ray.
 constexpr size_t kMaxRays = size_t(1) << 25;  // 1 GiB of records
 constexpr float kMinRayDirection = 0x1p-32f;
 std::vector<Ray> readRays(const std::string& path);
@@ -144,7 +144,7 @@ std::vector<Ray> makeRays(const Mesh& mesh, RayKind kind, size_t count, uint64_t
 
 // The mesh as renderer geometry, through the hierarchy.
 class MeshBvhGeometry : public Geometry {
-public:
+  public:
     MeshBvhGeometry(const Mesh& mesh, int material, const BvhBuildOptions& options);
     bool intersect(const Ray& ray, SurfaceHit& hit) const override;
     bool occluded(const Ray& ray) const override;
@@ -154,7 +154,7 @@ public:
     const Bvh& bvh() const { return bvh_; }
     const BvhBuildStats& stats() const { return stats_; }
 
-private:
+  private:
     const Mesh& mesh_;
     int material_;
     BvhBuildStats stats_;  // before bvh_: the build fills it

@@ -33,8 +33,16 @@ void Mesh::computeVertexNormals() {
         for (uint32_t i : t) normals[i] += n;
     }
     for (Vec3& n : normals) {
-        float len = glm::length(n);
-        n = (len > 0.0f && std::isfinite(len)) ? n / len : Vec3(0.0f, 1.0f, 0.0f);
+        // Scaled by the largest component first: the squared length of a tiny sum
+        // (1e-20) is subnormal and gave a normal of length 0.6 (found by fuzzing), and of
+        // a huge one (1e20) overflowed, falling back to +y.
+        float largest = maxComponent(glm::abs(n));
+        if (largest > 0.0f && std::isfinite(largest)) {
+            n /= largest;
+            n /= glm::length(n);
+        } else {
+            n = Vec3(0.0f, 1.0f, 0.0f);
+        }
     }
 }
 

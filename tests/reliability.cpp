@@ -130,6 +130,22 @@ TEST_SUITE("hard cases reliability") {
         CHECK(refusal(tri + "vw 0 1 x\n") == "x.obj:5: vertex weight field 'x' is not a number");
         CHECK(parseObj(tri + "vw 0 1 0.5 2 -0.25\n").triangleCount() == 1);
     }
+    TEST_CASE("hard case: vertex normals of tiny and huge triangles have unit length") {
+        // A triangle of size 1e-10 has a cross product of 1e-20, whose squared length is
+        // subnormal: the normal came out of length 0.6 (found by fuzzing,
+        // fuzz/corpus/obj/crash-0376038b...). One of size 1e19 overflowed to +y.
+        for (float size : {1e-10f, 1e-19f, 1e19f}) {
+            INFO(size);
+            Mesh m;
+            m.positions = {Vec3(0), Vec3(size, 0, 0), Vec3(0, 0, size)};
+            m.triangles = {{0, 1, 2}};
+            m.computeVertexNormals();
+            for (const Vec3& n : m.normals) {
+                CHECK(glm::length(n) == doctest::Approx(1.0f).epsilon(1e-6));
+                CHECK(n.y == doctest::Approx(-1.0f).epsilon(1e-6));
+            }
+        }
+    }
     TEST_CASE("hard case: user text quoted in an error message stays on one line") {
         auto messageOf = [](auto&& f) {
             try {

@@ -26,23 +26,21 @@ std::string printable(std::string_view text, size_t max) {
 }
 
 void Mesh::computeVertexNormals() {
-    normals.assign(positions.size(), Vec3(0.0f));
+    // In double: any float coordinates give a finite, non-subnormal cross product there.
+    // In float, a 1e-10 triangle's squared length was subnormal (a normal of length 0.6)
+    // and a 1e38 one overflowed to NaN (both found by fuzzing).
+    std::vector<Vec3d> sums(positions.size(), Vec3d(0.0));
     for (const auto& t : triangles) {
         // The unnormalized cross product weights each face by twice its area.
-        Vec3 n = glm::cross(positions[t[1]] - positions[t[0]], positions[t[2]] - positions[t[0]]);
-        for (uint32_t i : t) normals[i] += n;
+        Vec3d a(positions[t[0]]), b(positions[t[1]]), c(positions[t[2]]);
+        Vec3d n = glm::cross(b - a, c - a);
+        for (uint32_t i : t) sums[i] += n;
     }
-    for (Vec3& n : normals) {
-        // Scaled by the largest component first: the squared length of a tiny sum
-        // (1e-20) is subnormal and gave a normal of length 0.6 (found by fuzzing), and of
-        // a huge one (1e20) overflowed, falling back to +y.
-        float largest = maxComponent(glm::abs(n));
-        if (largest > 0.0f && std::isfinite(largest)) {
-            n /= largest;
-            n /= glm::length(n);
-        } else {
-            n = Vec3(0.0f, 1.0f, 0.0f);
-        }
+    normals.resize(positions.size());
+    for (size_t i = 0; i < sums.size(); ++i) {
+        double len = glm::length(sums[i]);
+        normals[i] =
+            (len > 0.0 && std::isfinite(len)) ? Vec3(sums[i] / len) : Vec3(0.0f, 1.0f, 0.0f);
     }
 }
 

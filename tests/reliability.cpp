@@ -133,8 +133,8 @@ TEST_SUITE("hard cases reliability") {
     TEST_CASE("hard case: vertex normals of tiny and huge triangles have unit length") {
         // A triangle of size 1e-10 has a cross product of 1e-20, whose squared length is
         // subnormal: the normal came out of length 0.6 (found by fuzzing,
-        // fuzz/corpus/obj/crash-0376038b...). One of size 1e19 overflowed to +y.
-        for (float size : {1e-10f, 1e-19f, 1e19f}) {
+        // fuzz/corpus/obj/crash-0376038b...). One of size 1e38 overflowed to NaN.
+        for (float size : {1e-10f, 1e-19f, 1e-30f, 1e19f, 1e38f}) {
             INFO(size);
             Mesh m;
             m.positions = {Vec3(0), Vec3(size, 0, 0), Vec3(0, 0, size)};

@@ -26,15 +26,21 @@ std::string printable(std::string_view text, size_t max) {
 }
 
 void Mesh::computeVertexNormals() {
-    normals.assign(positions.size(), Vec3(0.0f));
+    // In double: any float coordinates give a finite, non-subnormal cross product there.
+    // In float, a 1e-10 triangle's squared length was subnormal (a normal of length 0.6)
+    // and a 1e38 one overflowed to NaN (both found by fuzzing).
+    std::vector<Vec3d> sums(positions.size(), Vec3d(0.0));
     for (const auto& t : triangles) {
         // The unnormalized cross product weights each face by twice its area.
-        Vec3 n = glm::cross(positions[t[1]] - positions[t[0]], positions[t[2]] - positions[t[0]]);
-        for (uint32_t i : t) normals[i] += n;
+        Vec3d a(positions[t[0]]), b(positions[t[1]]), c(positions[t[2]]);
+        Vec3d n = glm::cross(b - a, c - a);
+        for (uint32_t i : t) sums[i] += n;
     }
-    for (Vec3& n : normals) {
-        float len = glm::length(n);
-        n = (len > 0.0f && std::isfinite(len)) ? n / len : Vec3(0.0f, 1.0f, 0.0f);
+    normals.resize(positions.size());
+    for (size_t i = 0; i < sums.size(); ++i) {
+        double len = glm::length(sums[i]);
+        normals[i] =
+            (len > 0.0 && std::isfinite(len)) ? Vec3(sums[i] / len) : Vec3(0.0f, 1.0f, 0.0f);
     }
 }
 
@@ -65,6 +71,30 @@ namespace {
 // - face lines: at most kMaxFaceVertices vertices (tinyobjloader's one-byte count);
 // - the totals: at most kMaxObjVertices vertices and kMaxObjTriangles triangles, counted
 //   here so memory is bounded before anything is allocated.
+// tinyobjloader's "vw VERTEX JOINT WEIGHT ..." (skin weights, unused here) converts each
+// joint to int unchecked: 1e38 is undefined behaviour (found by fuzzing). Every field must
+// be a plain number, the vertex and joints integers in int range.
+template <typename Where>
+void checkSkinWeights(std::string_view rest, const Where& where) {
+    size_t index = 0;
+    for (size_t i = 0; i < rest.size();) {
+        while (i < rest.size() && (rest[i] == ' ' || rest[i] == '\t')) ++i;
+        size_t j = i;
+        while (j < rest.size() && rest[j] != ' ' && rest[j] != '\t') ++j;
+        if (j == i) break;
+        std::string_view field = rest.substr(i, j - i);
+        double value = 0.0;
+        auto [ptr, ec] = std::from_chars(field.data(), field.data() + field.size(), value);
+        bool integer = index == 0 || index % 2 == 1;  // the vertex, then joint, weight, ...
+        if (ec != std::errc() || ptr != field.data() + field.size() || !std::isfinite(value) ||
+            (integer && !(value >= 0.0 && value < 2147483648.0 && value == std::floor(value))))
+            throw InputError(where() + "vertex weight field '" + printable(field, 40) +
+                             "' is not " + (integer ? "an index" : "a number"));
+        ++index;
+        i = j;
+    }
+}
+
 void checkLines(std::string_view text, const std::string& name, const ObjLimits& limits) {
     auto isBlank = [](char c) { return c == ' ' || c == '\t'; };
     size_t lineNumber = 0, vertices = 0, triangles = 0;
@@ -79,8 +109,12 @@ void checkLines(std::string_view text, const std::string& name, const ObjLimits&
         size_t first = 0;
         while (first < line.size() && isBlank(line[first])) ++first;
         line.remove_prefix(first);
-        if (line.size() < 2 || !isBlank(line[1]) || (line[0] != 'v' && line[0] != 'f')) continue;
         auto where = [&] { return name + ":" + std::to_string(lineNumber) + ": "; };
+        if (line.size() >= 3 && line[0] == 'v' && line[1] == 'w' && isBlank(line[2])) {
+            checkSkinWeights(line.substr(3), where);
+            continue;
+        }
+        if (line.size() < 2 || !isBlank(line[1]) || (line[0] != 'v' && line[0] != 'f')) continue;
         // Whitespace-separated fields after the keyword (tinyobjloader also splits at
         // blanks only).
         std::vector<std::string_view> fields;

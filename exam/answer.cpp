@@ -27,6 +27,9 @@ struct Token {
 };
 
 std::vector<Token> tokenize(const std::string& s) {
+    if (s.size() > kMaxAnswerLength)
+        throw std::invalid_argument("the answer is longer than " +
+                                    std::to_string(kMaxAnswerLength) + " characters");
     std::vector<Token> tokens;
     size_t i = 0;
     while (i < s.size()) {
@@ -130,7 +133,18 @@ class Parser {
         }
     }
 
+    // Counts the levels of recursion: deeper answers are refused, not a stack overflow.
+    struct Nesting {
+        int& depth;
+        explicit Nesting(int& d) : depth(d) {
+            if (++depth > kMaxAnswerNesting)
+                throw std::invalid_argument("the answer is nested too deeply");
+        }
+        ~Nesting() { --depth; }
+    };
+
     double unary() {
+        Nesting nesting(nesting_);
         if (isSymbol("-")) {
             ++pos_;
             return -unary();
@@ -152,6 +166,7 @@ class Parser {
     }
 
     double primary() {
+        Nesting nesting(nesting_);
         const Token t = peek();
         if (t.kind == Token::Number) {
             ++pos_;
@@ -185,29 +200,8 @@ class Parser {
     bool list_;
     size_t pos_ = 0;
     int depth_ = 0;
+    int nesting_ = 0;
 };
-
-// "(...)" or "[...]" around the whole text is dropped: "(1, 2, 3)" is the list 1, 2, 3.
-std::vector<Token> withoutOuterBrackets(std::vector<Token> tokens) {
-    while (tokens.size() >= 3 && tokens.front().kind == Token::Symbol &&
-           tokens.front().text == "(") {
-        int depth = 0;
-        size_t close = 0;
-        for (size_t i = 0; i + 1 < tokens.size(); ++i) {
-            if (tokens[i].kind != Token::Symbol) continue;
-            if (tokens[i].text == "(") ++depth;
-            if (tokens[i].text == ")" && --depth == 0) {
-                close = i;
-                break;
-            }
-        }
-        if (close != tokens.size() - 2) break;
-        tokens.erase(tokens.begin() + ptrdiff_t(close));
-        tokens.erase(tokens.begin());
-        tokens.front().spaceBefore = false;
-    }
-    return tokens;
-}
 
 // The index of the ')' that closes the '(' at `open`, or 0.
 size_t matchingClose(const std::vector<Token>& tokens, size_t open) {
@@ -218,6 +212,24 @@ size_t matchingClose(const std::vector<Token>& tokens, size_t open) {
         if (tokens[i].text == ")" && --depth == 0) return i;
     }
     return 0;
+}
+
+// "(...)" or "[...]" around the whole text is dropped: "(1, 2, 3)" is the list 1, 2, 3.
+// Every layer that wraps it all goes, in one copy (erasing layer by layer was quadratic).
+std::vector<Token> withoutOuterBrackets(const std::vector<Token>& tokens) {
+    size_t begin = 0, end = tokens.size() - 1;  // [begin, end): the tokens before End
+    auto isOpen = [&](size_t i) {
+        return tokens[i].kind == Token::Symbol && tokens[i].text == "(";
+    };
+    while (end - begin >= 2 && isOpen(begin) && matchingClose(tokens, begin) == end - 1) {
+        ++begin;
+        --end;
+    }
+    if (begin == 0) return tokens;
+    std::vector<Token> inner(tokens.begin() + ptrdiff_t(begin), tokens.begin() + ptrdiff_t(end));
+    inner.push_back(Token{});
+    inner.front().spaceBefore = false;
+    return inner;
 }
 
 std::vector<Token> slice(const std::vector<Token>& tokens, size_t begin, size_t end) {

@@ -1,6 +1,7 @@
 // Reading typed answers: numbers, vectors and small exact expressions such as sqrt(10)-1.
 #pragma once
 
+#include <cstddef>
 #include <string>
 #include <vector>
 
@@ -11,6 +12,13 @@ constexpr double kAbsoluteTolerance = 1e-3;
 constexpr double kRelativeTolerance = 1e-3;
 const char* toleranceText();
 bool withinTolerance(double answer, double expected);
+
+// Typed answers are bounded (issue 10's fuzzing: a line of 10^6 parentheses made the
+// reader quadratic and its recursion deep): longer or deeper answers are refused.
+constexpr size_t kMaxAnswerLength = 1000;  // characters
+// Levels of the reader's recursion: a parenthesis, sign, sqrt or ^ inside another takes
+// one or two, so this allows about 100 nested parentheses.
+constexpr int kMaxAnswerNesting = 200;
 
 // One number written as an expression: decimals (1.5, -2e-3), + - * / ^, parentheses,
 // sqrt(x) (also sqrt 2), pi, and a number written before sqrt or ( multiplies (2sqrt(3)).

@@ -93,6 +93,21 @@ TEST_SUITE("exam practice") {
         CHECK_THROWS_WITH_AS(evaluateExpression("x + 1"), doctest::Contains("unknown word 'x'"),
                              std::invalid_argument);
     }
+    TEST_CASE("answer parser: long and deeply nested answers are refused not overflowed") {
+        // Issue 10's fuzzing: 10^6 parentheses made the reader quadratic (a hang).
+        std::string deep = std::string(200000, '(') + "1" + std::string(200000, ')');
+        CHECK_THROWS_WITH_AS(parseNumberList(deep), doctest::Contains("longer than 1000"),
+                             std::invalid_argument);
+        std::string nested = "1+" + std::string(300, '(') + "1" + std::string(300, ')');
+        CHECK_THROWS_WITH_AS(evaluateExpression(nested), doctest::Contains("nested too deeply"),
+                             std::invalid_argument);
+        CHECK_THROWS_WITH_AS(evaluateExpression(std::string(500, '-') + "1"),
+                             doctest::Contains("nested too deeply"), std::invalid_argument);
+        // Ordinary nesting still reads.
+        CHECK(evaluateExpression("1+((((2))))*-(-3)") == 7.0);
+        CHECK(parseNumberList(std::string(400, '(') + "1, 2" + std::string(400, ')')) ==
+              std::vector<double>{1.0, 2.0});
+    }
     TEST_CASE("checking answers: the stated tolerance and none and yes/no and letters") {
         CHECK(withinTolerance(1.0009, 1.0));
         CHECK_FALSE(withinTolerance(1.0011, 1.0));

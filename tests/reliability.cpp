@@ -3,9 +3,11 @@
 // object, each with a clear error or a correct image. The OBJ and message cases were found
 // by the fuzz targets in fuzz/ (their inputs are in fuzz/corpus/).
 #include <cmath>
+#include <filesystem>
 #include <memory>
 
 #include "01_triangle/triangle_grid.hpp"
+#include "04_bvh/trace.hpp"
 #include "core/app.hpp"
 #include "core/mesh.hpp"
 #include "core/render.hpp"
@@ -66,6 +68,17 @@ Mesh oneTriangle() {
     return m;
 }
 
+// The closed cube [-1, 1]^3, two triangles a face, facing out.
+Mesh cube() {
+    Mesh m;
+    m.positions = {{-1, -1, -1}, {1, -1, -1}, {1, 1, -1}, {-1, 1, -1},
+                   {-1, -1, 1},  {1, -1, 1},  {1, 1, 1},  {-1, 1, 1}};
+    m.triangles = {{0, 2, 1}, {0, 3, 2}, {4, 5, 6}, {4, 6, 7}, {0, 1, 5}, {0, 5, 4},
+                   {1, 2, 6}, {1, 6, 5}, {2, 3, 7}, {2, 7, 6}, {3, 0, 4}, {3, 4, 7}};
+    m.computeVertexNormals();
+    return m;
+}
+
 double maxDifference(const Image& a, const Image& b) {
     double worst = 0.0;
     for (int y = 0; y < a.height(); ++y)
@@ -105,6 +118,33 @@ TEST_SUITE("hard cases reliability") {
         CHECK(refusal("v 0 0 0\rv 1 x 0\rv 0 1 0\rf 1 2 3\r") ==
               "x.obj:2: coordinate 'x' is not a number");
         CHECK(parseObj("v 0 0 0\r\nv 1 0 0\r\n\tv 0 1 0\r\nf 1 2 3\r\n").triangleCount() == 1);
+    }
+    TEST_CASE("hard case: OBJ vertex weights with a joint out of int range are refused") {
+        // tinyobjloader converts a "vw" joint to int unchecked: 1e38 was undefined
+        // behaviour (found by fuzzing, fuzz/corpus/obj/crash-f1210a...).
+        const std::string tri = "v 0 0 0\nv 1 0 0\nv 0 1 0\nf 1 2 3\n";
+        CHECK(refusal(tri + "vw 0 1e38 0.5\n") ==
+              "x.obj:5: vertex weight field '1e38' is not an index");
+        CHECK(refusal(tri + "vw 0 1 0.5 nan 1\n") ==
+              "x.obj:5: vertex weight field 'nan' is not an index");
+        CHECK(refusal(tri + "vw 0 1 x\n") == "x.obj:5: vertex weight field 'x' is not a number");
+        CHECK(parseObj(tri + "vw 0 1 0.5 2 -0.25\n").triangleCount() == 1);
+    }
+    TEST_CASE("hard case: vertex normals of tiny and huge triangles have unit length") {
+        // A triangle of size 1e-10 has a cross product of 1e-20, whose squared length is
+        // subnormal: the normal came out of length 0.6 (found by fuzzing,
+        // fuzz/corpus/obj/crash-0376038b...). One of size 1e38 overflowed to NaN.
+        for (float size : {1e-10f, 1e-19f, 1e-30f, 1e19f, 1e38f}) {
+            INFO(size);
+            Mesh m;
+            m.positions = {Vec3(0), Vec3(size, 0, 0), Vec3(0, 0, size)};
+            m.triangles = {{0, 1, 2}};
+            m.computeVertexNormals();
+            for (const Vec3& n : m.normals) {
+                CHECK(glm::length(n) == doctest::Approx(1.0f).epsilon(1e-6));
+                CHECK(n.y == doctest::Approx(-1.0f).epsilon(1e-6));
+            }
+        }
     }
     TEST_CASE("hard case: user text quoted in an error message stays on one line") {
         auto messageOf = [](auto&& f) {
@@ -221,5 +261,127 @@ TEST_SUITE("hard cases reliability") {
                     REQUIRE(maxComponent(glm::abs(image.at(x, y) - ambientOnly)) < 1e-6f);
                 }
         }
+    }
+}
+
+// Step 04's hierarchy (build and the trace command's path) on the same hard cases.
+TEST_SUITE("hard cases reliability") {
+    TEST_CASE("hard case: BVH over a million identical triangles builds bounded and traces") {
+        // Identical centroids: no split plane separates them; every builder must still
+        // stop (depth cap, leaves of bounded size) and the nearest hit is the triangle.
+        Mesh one = oneTriangle();
+        Mesh many = one;
+        many.triangles.assign(1000000, one.triangles[0]);
+        for (BvhBuilder b : {BvhBuilder::BinnedSah, BvhBuilder::Midpoint}) {
+            INFO(bvhBuilderName(b));
+            BvhBuildOptions options;
+            options.builder = b;
+            BvhBuildStats stats;
+            Bvh bvh = buildBvh(many, options, &stats);
+            CHECK(stats.depth <= options.maxDepth);
+            CHECK(bvh.nodes.size() < 2 * many.triangleCount());
+            Ray ray(Vec3(0.2f, 0.2f, 3.0f), Vec3(0, 0, -1));
+            TraceHit hit = traceNearest(bvh, ray);
+            CHECK(hit.triangle < 1000000u);
+            // The plane through the triangle: z = 0.2 x - 0.1 y.
+            CHECK(hit.t == doctest::Approx(3.0 - (0.2 * 0.2 - 0.1 * 0.2)).epsilon(1e-5));
+            CHECK(traceOccluded(bvh, ray));
+            CHECK(traceNearest(bvh, Ray(Vec3(2.0f, 2.0f, 3.0f), Vec3(0, 0, -1))).triangle ==
+                  kNoPrimitive);
+        }
+    }
+    TEST_CASE("hard case: BVH zero-area triangles are never hit") {
+        Mesh clean = cube();
+        Mesh withDegenerate = clean;
+        size_t base = withDegenerate.positions.size();
+        // A point, a segment across a face, and a segment through the cube's inside.
+        withDegenerate.positions.insert(withDegenerate.positions.end(),
+                                        {Vec3(0.3f, 0.2f, -1.0f), Vec3(-1, -1, -1), Vec3(1, 1, -1),
+                                         Vec3(-1, -1, 1), Vec3(0, 0, 0)});
+        withDegenerate.triangles.push_back({uint32_t(base), uint32_t(base), uint32_t(base)});
+        withDegenerate.triangles.push_back(
+            {uint32_t(base + 1), uint32_t(base + 2), uint32_t(base + 1)});
+        withDegenerate.triangles.push_back(
+            {uint32_t(base + 3), uint32_t(base + 4), uint32_t(base + 4)});
+        Bvh bvh = buildBvh(withDegenerate, BvhBuildOptions{});
+        std::vector<Ray> rays = makeRays(clean, RayKind::Random, 2000, 7);
+        rays.emplace_back(Vec3(0.3f, 0.2f, -5.0f), Vec3(0, 0, 1));  // at the point
+        rays.emplace_back(Vec3(0.1f, 0.1f, -5.0f), Vec3(0, 0, 1));  // along the segment
+        for (const Ray& ray : rays) {
+            TraceHit got = traceNearest(bvh, ray), want = traceBruteForce(clean, ray);
+            // A miss, or one of the cube's own triangles (the degenerate ones come after).
+            REQUIRE((got.triangle == kNoPrimitive || got.triangle < clean.triangleCount()));
+            REQUIRE(hitsAgree(got, want));
+        }
+    }
+    TEST_CASE("hard case: BVH rays from inside a closed mesh hit its inner walls") {
+        // A camera inside an object: every ray leaves through a wall, at the distance
+        // to the wall along the ray.
+        Mesh m = cube();
+        Bvh bvh = buildBvh(m, BvhBuildOptions{});
+        Vec3 eye(0.2f, -0.3f, 0.1f);
+        std::vector<Ray> rays = makeRays(m, RayKind::Random, 500, 3);
+        for (const Ray& r : rays) {
+            Ray ray(eye, r.direction);
+            TraceHit hit = traceNearest(bvh, ray);
+            REQUIRE(hit.triangle != kNoPrimitive);
+            double exit = kInfinity<double>;
+            for (int axis = 0; axis < 3; ++axis) {
+                double d = ray.direction[axis], o = ray.origin[axis];
+                if (d != 0.0) exit = std::min(exit, ((d > 0.0 ? 1.0 : -1.0) - o) / d);
+            }
+            REQUIRE(hit.t == doctest::Approx(exit).epsilon(1e-5));
+        }
+    }
+    TEST_CASE("hard case: BVH trace input with NaN or infinity is refused with a message") {
+        // The trace command reads the mesh through parseObj and the rays through readRays:
+        // both refuse a NaN or an infinity with the line or ray that has it, before any
+        // hierarchy is built.
+        CHECK(refusal("v 0 0 0\nv nan 0 0\nv 0 1 0\nf 1 2 3\n") ==
+              "x.obj:2: coordinate 'nan' is non-finite");
+        CHECK(refusal("v 0 0 0\nv 1 0 inf\nv 0 1 0\nf 1 2 3\n") ==
+              "x.obj:2: coordinate 'inf' is non-finite");
+        auto rayRefusal = [](std::vector<float> record) {
+            try {
+                parseRays(record.data(), record.size() * sizeof(float), "rays file 'r.bin'");
+            } catch (const InputError& e) {
+                return std::string(e.what());
+            }
+            return std::string("(accepted)");
+        };
+        const float nan = std::nanf(""), inf = kInfinity<float>;
+        CHECK(rayRefusal({0, 0, 0, 0, 0, 0, 1, inf}) == "(accepted)");
+        CHECK(rayRefusal({0, 0, 0, 0, 0, 0, 1, inf, 0, nan, 0, 0, 0, 0, 1, inf}) ==
+              "rays file 'r.bin': ray 1: NaN value");
+        CHECK(rayRefusal({0, 0, 0, 0, inf, 0, 1, inf}) ==
+              "rays file 'r.bin': ray 0: infinite origin or direction");
+        CHECK(rayRefusal({0, 0, 0, 0, 0, -0.0f, 0, 1}) ==
+              "rays file 'r.bin': ray 0: zero direction");
+        // A subnormal direction made a hit at t = -infinity (found by fuzzing).
+        CHECK(rayRefusal({0.3f, 0.2f, 5, -inf, 0, 5.9e-39f, 2.3e-38f, 0}) ==
+              "rays file 'r.bin': ray 0: direction too short (largest component below 2^-32)");
+        CHECK(rayRefusal({0, 0, 0, 0, 0, 0, 0x1p-32f, 1}) == "(accepted)");
+        CHECK(rayRefusal({0, 0, 0, 0, 0, 0}) ==
+              "rays file 'r.bin': size 24 bytes is not a multiple of 32 (8 float32 per ray)");
+        // tmin > tmax is an empty interval: read, and a miss.
+        Mesh m = cube();
+        Bvh bvh = buildBvh(m, BvhBuildOptions{});
+        std::vector<float> empty = {0, 0, -5, 5, 0, 0, 1, 3};
+        std::vector<Ray> rays = parseRays(empty.data(), 32, "r.bin");
+        CHECK(traceNearest(bvh, rays[0]).triangle == kNoPrimitive);
+        CHECK(traceBruteForce(m, rays[0]).triangle == kNoPrimitive);
+    }
+    TEST_CASE("hard case: a rays file larger than the limit is refused before reading") {
+        // A sparse file: its size says more than kMaxRays rays, no disk or memory is used.
+        test::TempDir dir;
+        std::string path = dir.file("huge.bin");
+        std::ofstream(path, std::ios::binary).put('\0');
+        std::filesystem::resize_file(path, (kMaxRays + 1) * sizeof(RayRecord));
+        CHECK_THROWS_WITH_AS(
+            readRays(path),
+            ("rays file '" + path + "': " + std::to_string((kMaxRays + 1) * sizeof(RayRecord)) +
+             " bytes is more than the limit of 33554432 rays")
+                .c_str(),
+            InputError);
     }
 }

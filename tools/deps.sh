@@ -20,7 +20,7 @@ pkgs_for() {
     echo chromium
     command -v node >/dev/null 2>&1 || echo nodejs npm # Debian's Node.js only when none is installed
     ;;
-  fuzz) echo clang libclang-rt-dev ;;
+  fuzz) echo clang libclang-rt-dev python3-hypothesis ;;
   grade) echo bubblewrap python3 ;;
   bench) echo libbenchmark-dev libembree-dev python3-numpy linux-perf ;; # perf: step 05 README
   *)

@@ -14,6 +14,7 @@ A marker, as in steps/01_triangle/triangle.cpp:
 import glob
 import os
 import re
+import stat
 import xml.etree.ElementTree as ET
 from dataclasses import dataclass, field
 
@@ -145,9 +146,28 @@ class CaseResult:
     message: str = ""  # the first failure, one line
 
 
+# The largest results file read (bytes): one test program's results are far smaller, and a
+# student's code, which writes into the same process, must not make the grader parse
+# gigabytes.
+MAX_RESULT_BYTES = 64 << 20
+
+
+def _case_elements(case):
+    """The elements of a <TestCase> in document order, without descending into a nested
+    <TestSuite> or <TestCase> (doctest writes none; a forged file may nest thousands,
+    which walking every subtree made quadratic)."""
+    stack = list(reversed(case))
+    while stack:
+        el = stack.pop()
+        if el.tag in ("TestSuite", "TestCase"):
+            continue
+        yield el
+        stack.extend(reversed(el))
+
+
 def _first_failure(case):
     """The first failed assertion or exception of a <TestCase>, as one line."""
-    for el in case.iter():
+    for el in _case_elements(case):
         if el.tag == "Expression" and el.get("success") == "false":
             orig = (el.findtext("Original") or "").strip()
             exp = (el.findtext("Expanded") or "").strip()
@@ -158,7 +178,7 @@ def _first_failure(case):
                 text += f" threw: {exc}"
             elif exp and exp != orig:
                 text += f" is {exp}"
-            infos = [i.text.strip() for i in el.iter("Info") if i.text]
+            infos = [i.text.strip() for i in el.findall("Info") if i.text]
             if infos:
                 text += " [" + "; ".join(infos) + "]"
             return f"{where}: {text}"
@@ -169,18 +189,42 @@ def _first_failure(case):
     return ""
 
 
-def case_results(path_or_text):
-    """Every <TestCase> in one doctest XML file (or string): suite, name, passed, message."""
+def _parse_results(path_or_text):
+    """The root element, or None when the input cannot be read as XML."""
     try:
-        if path_or_text.lstrip().startswith("<"):
-            root = ET.fromstring(path_or_text)
-        else:
-            root = ET.parse(path_or_text).getroot()
-    except (ET.ParseError, OSError):
+        if isinstance(path_or_text, str) and path_or_text.lstrip().startswith("<"):
+            if len(path_or_text) > MAX_RESULT_BYTES:
+                return None
+            return ET.fromstring(path_or_text)
+        # A FIFO or device would block or never end: regular files only, of bounded size.
+        info = os.stat(path_or_text)
+        if not stat.S_ISREG(info.st_mode) or info.st_size > MAX_RESULT_BYTES:
+            return None
+        with open(path_or_text, "rb") as f:
+            data = f.read(MAX_RESULT_BYTES + 1)
+        if len(data) > MAX_RESULT_BYTES:
+            return None
+        return ET.fromstring(data)
+    # ParseError: malformed (also expat's refusal of entity expansion bombs); LookupError: an
+    # unknown encoding="..." in the declaration; ValueError: a NUL in a path.
+    except (ET.ParseError, OSError, LookupError, ValueError):
+        return None
+
+
+def case_results(path_or_text):
+    """Every <TestCase> in one doctest XML file (or string starting with "<"): suite, name,
+    passed, message (one line; empty when passed).
+
+    Never raises for what the file holds: a missing, unreadable, non-regular, truncated,
+    malformed or oversized (over MAX_RESULT_BYTES) input gives [], XML that is not
+    doctest's gives the test cases it has (none, or failed ones when their results are
+    missing). Time and memory are linear in the input's size."""
+    root = _parse_results(path_or_text)
+    if root is None:
         return []
     results = []
     for suite in root.iter("TestSuite"):
-        for case in suite.iter("TestCase"):
+        for case in suite.findall("TestCase"):  # doctest writes them as the suite's children
             if case.get("skipped") == "true":  # filtered out of this run
                 continue
             res = case.find("OverallResultsAsserts")

@@ -32,30 +32,45 @@ TraceHit traceBruteForce(const Mesh& mesh, const Ray& ray) {
 
 std::vector<Ray> readRays(const std::string& path) {
     std::error_code ec;
-    if (!std::filesystem::is_regular_file(path, ec))
-        throw InputError("rays file '" + path + "': no such file");
+    std::string name = "rays file '" + path + "'";
+    if (!std::filesystem::is_regular_file(path, ec)) throw InputError(name + ": no such file");
     uintmax_t size = std::filesystem::file_size(path, ec);
-    if (ec) throw InputError("rays file '" + path + "': cannot read its size");
-    if (size % sizeof(RayRecord) != 0)
-        throw InputError("rays file '" + path + "': size " + std::to_string(size) +
-                         " bytes is not a multiple of 32 (8 float32 per ray)");
-    if (size == 0) throw InputError("rays file '" + path + "' is empty");
-    std::vector<RayRecord> records(size / sizeof(RayRecord));
+    if (ec) throw InputError(name + ": cannot read its size");
+    // Refused before reading: a file too large for memory is a message, not an OOM kill.
+    if (size / sizeof(RayRecord) > kMaxRays)
+        throw InputError(name + ": " + std::to_string(size) + " bytes is more than the limit of " +
+                         std::to_string(kMaxRays) + " rays");
+    std::vector<char> bytes(size);
     std::ifstream in(path, std::ios::binary);
-    if (!in.read(reinterpret_cast<char*>(records.data()), std::streamsize(size)))
-        throw InputError("rays file '" + path + "': read failed");
+    if (!in.read(bytes.data(), std::streamsize(size))) throw InputError(name + ": read failed");
+    return parseRays(bytes.data(), bytes.size(), name);
+}
+
+std::vector<Ray> parseRays(const void* data, size_t size, const std::string& name) {
+    if (size % sizeof(RayRecord) != 0)
+        throw InputError(name + ": size " + std::to_string(size) +
+                         " bytes is not a multiple of 32 (8 float32 per ray)");
+    if (size == 0) throw InputError(name + " is empty");
+    if (size / sizeof(RayRecord) > kMaxRays)
+        throw InputError(name + ": more than the limit of " + std::to_string(kMaxRays) + " rays");
     std::vector<Ray> rays;
-    rays.reserve(records.size());
-    for (size_t i = 0; i < records.size(); ++i) {
-        const RayRecord& r = records[i];
+    rays.reserve(size / sizeof(RayRecord));
+    for (size_t i = 0; i < size / sizeof(RayRecord); ++i) {
+        RayRecord r;
+        std::memcpy(&r, static_cast<const char*>(data) + i * sizeof(RayRecord), sizeof r);
         Vec3 o(r.origin[0], r.origin[1], r.origin[2]),
             d(r.direction[0], r.direction[1], r.direction[2]);
-        std::string where = "rays file '" + path + "': ray " + std::to_string(i) + ": ";
+        auto where = [&] { return name + ": ray " + std::to_string(i) + ": "; };
         if (std::isnan(o.x) || std::isnan(o.y) || std::isnan(o.z) || std::isnan(d.x) ||
             std::isnan(d.y) || std::isnan(d.z) || std::isnan(r.tmin) || std::isnan(r.tmax))
-            throw InputError(where + "NaN value");
-        if (!isFinite(o) || !isFinite(d)) throw InputError(where + "infinite origin or direction");
-        if (isZero(d)) throw InputError(where + "zero direction");
+            throw InputError(where() + "NaN value");
+        if (!isFinite(o) || !isFinite(d))
+            throw InputError(where() + "infinite origin or direction");
+        if (isZero(d)) throw InputError(where() + "zero direction");
+        // Distances along a direction this short overflow float (issue 10's fuzzing: a
+        // subnormal direction gave a "hit" at t = -infinity).
+        if (maxComponent(glm::abs(d)) < kMinRayDirection)
+            throw InputError(where() + "direction too short (largest component below 2^-32)");
         rays.emplace_back(o, d, r.tmin, r.tmax);
     }
     return rays;

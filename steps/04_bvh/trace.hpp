@@ -151,10 +151,17 @@ struct RayRecord {
 };
 static_assert(sizeof(RayRecord) == 32, "the RAYS.bin record");
 
-// Reads and checks a rays file: size a multiple of 32 bytes, finite origins and
-// directions, non-zero directions, no NaN in tmin/tmax. Throws InputError naming the
-// file and the first bad ray.
+// Reads and checks a rays file: size a multiple of 32 bytes, at most kMaxRays rays (a
+// larger file is refused before anything is read), finite origins and directions, each
+// direction's largest component at least kMinRayDirection, no NaN in tmin/tmax. tmin
+// and tmax may be infinite, and tmin > tmax is an empty interval: that ray misses. Throws
+// InputError naming the file and the first bad ray.
+constexpr size_t kMaxRays = size_t(1) << 25;  // 1 GiB of records
+constexpr float kMinRayDirection = 0x1p-32f;
 std::vector<Ray> readRays(const std::string& path);
+// The same checks on the bytes of a rays file in memory; `name` starts the messages
+// ("rays file 'r.bin'").
+std::vector<Ray> parseRays(const void* data, size_t size, const std::string& name);
 void writeRays(const std::string& path, const std::vector<Ray>& rays);
 // HITS.bin: float32 t, uint32 triangle per ray; written atomically (temp file + rename).
 void writeHits(const std::string& path, const std::vector<TraceHit>& hits);

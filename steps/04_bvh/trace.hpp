@@ -2,6 +2,7 @@
 // files of the `trace` command, batch tracing on threads, and brute force to check it.
 #pragma once
 
+#include <cmath>
 #include <cstdint>
 #include <string>
 #include <vector>
@@ -67,6 +68,34 @@ decltype(auto) withWatertightAxes(const WatertightRay& r, F&& f) {
     }
 }
 
+// The same test in double, for the rare triangle whose float edge functions overflow
+// (coordinates beyond about 1e19 from the ray origin: their products pass 3.4e38, and
+// inf - inf is NaN). The sheared vertices are still finite floats; in double the products
+// cannot overflow, so such a triangle is hit instead of silently missed.
+template <typename Axes>
+[[gnu::noinline]] bool intersectLeafTriangleDouble(Axes, const WatertightRay& r,
+                                                   const LeafTriangle& tri, float& tmax,
+                                                   float* uOut, float* vOut) {
+    constexpr int kx = Axes::kx, ky = Axes::ky, kz = Axes::kz;
+    const glm::dvec3 o(r.origin);
+    const glm::dvec3 av = glm::dvec3(tri.a) - o, bv = glm::dvec3(tri.b) - o,
+                     cv = glm::dvec3(tri.c) - o;
+    const double sx = r.sx, sy = r.sy, sz = r.sz;
+    double ax = av[kx] - sx * av[kz], ay = av[ky] - sy * av[kz];
+    double bx = bv[kx] - sx * bv[kz], by = bv[ky] - sy * bv[kz];
+    double cx = cv[kx] - sx * cv[kz], cy = cv[ky] - sy * cv[kz];
+    double u = cx * by - cy * bx, v = ax * cy - ay * cx, w = bx * ay - by * ax;
+    if ((u < 0.0 || v < 0.0 || w < 0.0) && (u > 0.0 || v > 0.0 || w > 0.0)) return false;
+    double det = u + v + w;
+    if (det == 0.0 || !std::isfinite(det)) return false;
+    float t = float((u * sz * av[kz] + v * sz * bv[kz] + w * sz * cv[kz]) / det);
+    if (!(t >= r.tmin && t <= tmax)) return false;
+    tmax = t;
+    if (uOut) *uOut = float(v / det);
+    if (vOut) *vOut = float(w / det);
+    return true;
+}
+
 // A hit in [ray.tmin, tmax] lowers tmax to it; (u, v) are the barycentrics of b and c.
 // Axes must be the ray's order (r.kx, r.ky, r.kz); the arithmetic is exercise 1.5's.
 template <typename Axes>
@@ -87,9 +116,11 @@ inline bool intersectLeafTriangle(Axes, const WatertightRay& r, const LeafTriang
         v = float(double(ax) * double(cy) - double(ay) * double(cx));
         w = float(double(bx) * double(ay) - double(by) * double(ax));
     }
+    float det = u + v + w;  // not finite exactly when an edge function overflowed
+    if (!std::isfinite(det)) [[unlikely]]
+        return intersectLeafTriangleDouble(Axes{}, r, tri, tmax, uOut, vOut);
     if ((u < 0.0f || v < 0.0f || w < 0.0f) && (u > 0.0f || v > 0.0f || w > 0.0f)) return false;
-    float det = u + v + w;
-    if (det == 0.0f || !std::isfinite(det)) return false;
+    if (det == 0.0f) return false;
     float az = r.sz * a[kz], bz = r.sz * b[kz], cz = r.sz * c[kz];
     float t = (u * az + v * bz + w * cz) / det;
     if (!(t >= r.tmin && t <= tmax)) return false;

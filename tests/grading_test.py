@@ -332,11 +332,15 @@ def hostile_body(kind, token, work, port):
         return None
     if kind == "compile":
         return ['#include "/dev/zero"']
-    if kind == "compile-time":  # some 10^10 steps of constant evaluation: minutes of GCC
-        return ["constexpr auto spin = [] {", "    unsigned long n = 0;",
-                "    for (unsigned long i = 0; i < 200000; ++i)",
-                "        for (unsigned long j = 0; j < 200000; ++j) n += i ^ j;",
-                "    return n;", "};", "static_assert(spin() != 1);",
+    if kind == "compile-time":
+        # Minutes of constant evaluation. GCC stops one evaluation after 2^33 operations
+        # (-fconstexpr-ops-limit), which a fast machine reaches within the build's time
+        # limit, so: 64 evaluations, each below that cap, each with its own argument (GCC
+        # caches a constexpr call's result).
+        return ["constexpr auto spin = [](unsigned long k) {", "    unsigned long n = k;",
+                "    for (unsigned long i = 0; i < 30000; ++i)",
+                "        for (unsigned long j = 0; j < 30000; ++j) n += i ^ j ^ k;",
+                "    return n;", "};"] + [f"static_assert(spin({k}) != 1);" for k in range(64)] + [
                 'throw std::logic_error("compiled");']
     raise ValueError(kind)
 

@@ -373,9 +373,36 @@ TEST_SUITE("hard cases 04") {
             CHECK(h.triangle == 0u);
             CHECK(h.t == doctest::Approx(5e20).epsilon(1e-6));
             // Seen from the side and behind the ray: still a miss.
-            CHECK(traceNearest(bvh, Ray(Vec3(3e21f, 0.0f, 0.0f), Vec3(0.0f, 0.0f, -1.0f))).triangle ==
+            CHECK(
+                traceNearest(bvh, Ray(Vec3(3e21f, 0.0f, 0.0f), Vec3(0.0f, 0.0f, -1.0f))).triangle ==
+                kNoPrimitive);
+            CHECK(traceNearest(bvh, Ray(Vec3(0.0f), Vec3(0.0f, 0.0f, 1.0f))).triangle ==
                   kNoPrimitive);
-            CHECK(traceNearest(bvh, Ray(Vec3(0.0f), Vec3(0.0f, 0.0f, 1.0f))).triangle == kNoPrimitive);
+        }
+    }
+    TEST_CASE("hard case: a tiny triangle behind a ray with a huge direction is missed") {
+        // Found by fuzz_rays. With |d| = 1e28 the scaled depths are about 1e-27 and the edge
+        // functions of a triangle 1e-15 across about 1e-30: their products underflow to a
+        // signed zero, and t = -0 passed t >= tmin = 0 although the triangle lies behind.
+        Mesh m;
+        m.positions = {{-1e-15f, -1e-15f, 3.0f}, {1e-15f, -1e-15f, 3.0f}, {0.0f, 1e-15f, 3.0f}};
+        m.triangles = {{0, 1, 2}};
+        // The fuzzer's own input: a zero-area triangle whose line passes through the ray.
+        Mesh flat;
+        flat.positions = {{0.0f, 0.0f, 3.0f}, {1.0f, 1.0f, 3.0f}, {2.0f, 2.0f, 3.0f}};
+        flat.triangles = {{0, 1, 2}};
+        Ray away(Vec3(0.0f, 0.0f, -5.0f), Vec3(0.0f, 0.0f, -1e28f));
+        Ray awayFuzz(Vec3(1.0f, 1.0f, -5.0f), Vec3(0.0f, 8.149072e-10f, -1.0603488e28f));
+        CHECK(traceBruteForce(m, away).triangle == kNoPrimitive);
+        CHECK(traceBruteForce(flat, awayFuzz).triangle == kNoPrimitive);
+        // Towards it the same triangle is hit, at 8 / 1e28.
+        TraceHit ahead = traceBruteForce(m, Ray(Vec3(0.0f, 0.0f, -5.0f), Vec3(0.0f, 0.0f, 1e28f)));
+        CHECK(ahead.triangle == 0u);
+        CHECK(ahead.t == doctest::Approx(8e-28).epsilon(1e-5));
+        for (BvhBuilder b : kExerciseBuilders) {
+            INFO(bvhBuilderName(b));
+            CHECK(traceNearest(buildBvh(m, optionsFor(b)), away).triangle == kNoPrimitive);
+            CHECK(traceNearest(buildBvh(flat, optionsFor(b)), awayFuzz).triangle == kNoPrimitive);
         }
     }
 }

@@ -4,6 +4,7 @@
 
 #include <cmath>
 #include <cstdint>
+#include <limits>
 #include <string>
 #include <vector>
 
@@ -122,7 +123,13 @@ inline bool intersectLeafTriangle(Axes, const WatertightRay& r, const LeafTriang
     if ((u < 0.0f || v < 0.0f || w < 0.0f) && (u > 0.0f || v > 0.0f || w > 0.0f)) return false;
     if (det == 0.0f) return false;
     float az = r.sz * a[kz], bz = r.sz * b[kz], cz = r.sz * c[kz];
-    float t = (u * az + v * bz + w * cz) / det;
+    float tScaled = u * az + v * bz + w * cz;
+    // Below the normal range the products may have underflowed to zeros whose signs no
+    // longer add up (t = -0 for a triangle behind the ray, found by fuzz_rays with
+    // |d| = 1e28): decide in double, where they do not underflow.
+    if (std::fabs(tScaled) < std::numeric_limits<float>::min()) [[unlikely]]
+        return intersectLeafTriangleDouble(Axes{}, r, tri, tmax, uOut, vOut);
+    float t = tScaled / det;
     if (!(t >= r.tmin && t <= tmax)) return false;
     tmax = t;
     if (uOut) *uOut = v / det;

@@ -3,7 +3,6 @@
 #pragma once
 
 #include <CLI/CLI.hpp>
-
 #include <functional>
 #include <optional>
 #include <string>
@@ -22,9 +21,9 @@ struct CommonOptions {
     int height = 480;
     std::string scene;
     uint64_t seed = 1;
-    bool json = false;        // print the measurements as JSON on stdout
-    std::string reportPath;   // also write them as JSON to this file
-    int threads = 0;          // 0: every hardware thread
+    bool json = false;       // print the measurements as JSON on stdout
+    std::string reportPath;  // also write them as JSON to this file
+    int threads = 0;         // 0: every hardware thread
     std::string dataDir;
     std::string eye, look, up;  // "X,Y,Z"
     float fov = 0.0f;           // degrees; 0: the scene's

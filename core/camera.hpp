@@ -53,8 +53,8 @@ struct CameraT {
         if (glm::dot(u, u) < T(1e-12)) {
             Vec3T<T> a = glm::abs(w);
             Vec3T<T> fallback = (a.x <= a.y && a.x <= a.z) ? Vec3T<T>(1, 0, 0)
-                                : (a.y <= a.z)              ? Vec3T<T>(0, 1, 0)
-                                                            : Vec3T<T>(0, 0, 1);
+                                : (a.y <= a.z)             ? Vec3T<T>(0, 1, 0)
+                                                           : Vec3T<T>(0, 0, 1);
             u = glm::cross(w, fallback);
         }
         u = glm::normalize(u);
@@ -79,8 +79,7 @@ struct CameraT {
         CameraBasisT<T> b = basis();
         return directionThrough(b, px, py, width, height);
     }
-    Vec3T<T> directionThrough(const CameraBasisT<T>& b, T px, T py, int width,
-                              int height) const {
+    Vec3T<T> directionThrough(const CameraBasisT<T>& b, T px, T py, int width, int height) const {
         T h = halfHeight();
         T sx = (T(2) * px / T(width) - T(1)) * aspect * h;
         T sy = (T(1) - T(2) * py / T(height)) * h;

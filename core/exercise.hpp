@@ -9,7 +9,8 @@ namespace boxes {
 
 struct NotImplemented : std::logic_error {
     explicit NotImplemented(const std::string& exercise)
-        : std::logic_error("exercise " + exercise + " is not implemented yet"), exercise(exercise) {}
+        : std::logic_error("exercise " + exercise + " is not implemented yet"),
+          exercise(exercise) {}
     std::string exercise;
 };
 

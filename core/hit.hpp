@@ -17,7 +17,7 @@ struct SurfaceHit {
     float u = 0.0f, v = 0.0f;    // barycentric coordinates (triangles) or 0
     int material = 0;
     uint32_t primitive = kNoPrimitive;  // triangle index in file order, or sphere/plane index
-    int object = -1;                     // the scene object: spheres, then planes, then geometries
+    int object = -1;                    // the scene object: spheres, then planes, then geometries
     enum class Kind : uint8_t { None, Sphere, Plane, Triangle } kind = Kind::None;
 };
 

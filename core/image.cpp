@@ -2,13 +2,13 @@
 
 #include <stb/stb_image.h>
 #include <stb/stb_image_write.h>
+#include <unistd.h>
 
 #include <algorithm>
 #include <cstdio>
 #include <filesystem>
 #include <fstream>
 #include <stdexcept>
-#include <unistd.h>
 
 namespace boxes {
 
@@ -25,8 +25,8 @@ Image::Image(int width, int height, Vec3 fill) : width_(width), height_(height) 
 uint8_t encodeSrgb8(float linear) {
     if (!(linear > 0.0f)) return 0;  // also maps NaN to black
     if (linear >= 1.0f) return 255;
-    float s = linear <= 0.0031308f ? 12.92f * linear
-                                   : 1.055f * std::pow(linear, 1.0f / 2.4f) - 0.055f;
+    float s =
+        linear <= 0.0031308f ? 12.92f * linear : 1.055f * std::pow(linear, 1.0f / 2.4f) - 0.055f;
     return uint8_t(std::lround(s * 255.0f));
 }
 
@@ -48,8 +48,8 @@ std::vector<uint8_t> Image::toRgb8() const {
 Image Image::fromRgb8(int width, int height, const uint8_t* rgb) {
     Image image(width, height);
     for (size_t i = 0; i < image.pixels_.size(); ++i)
-        image.pixels_[i] = Vec3(decodeSrgb8(rgb[3 * i]), decodeSrgb8(rgb[3 * i + 1]),
-                                decodeSrgb8(rgb[3 * i + 2]));
+        image.pixels_[i] =
+            Vec3(decodeSrgb8(rgb[3 * i]), decodeSrgb8(rgb[3 * i + 1]), decodeSrgb8(rgb[3 * i + 2]));
     return image;
 }
 

@@ -42,8 +42,8 @@ uint8_t encodeSrgb8(float linear);
 float decodeSrgb8(uint8_t value);
 
 struct ImageDifference {
-    double rmse = 0.0;       // over all channels, in linear units
-    double maxError = 0.0;   // largest absolute channel difference
+    double rmse = 0.0;           // over all channels, in linear units
+    double maxError = 0.0;       // largest absolute channel difference
     size_t pixelsDiffering = 0;  // pixels with any channel difference above the threshold
 };
 // Throws std::invalid_argument when the sizes differ.

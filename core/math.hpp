@@ -80,8 +80,12 @@ T fresnelDielectric(T cosI, T nFrom, T nTo) {
 }
 
 // Neighbouring floats, for conservative bounds (pbrt-v4, section 6.8).
-inline float nextFloatUp(float v) { return std::nextafter(v, kInfinity<float>); }
-inline float nextFloatDown(float v) { return std::nextafter(v, -kInfinity<float>); }
+inline float nextFloatUp(float v) {
+    return std::nextafter(v, kInfinity<float>);
+}
+inline float nextFloatDown(float v) {
+    return std::nextafter(v, -kInfinity<float>);
+}
 
 // Bound on the relative error of n floating-point operations (Higham; pbrt's gamma(n)).
 template <typename T>

@@ -36,13 +36,26 @@ public:
     bool onKey(int key) {
         const float step = glm::radians(5.0f);
         switch (key) {
-            case SDLK_LEFT: rotate(-step, 0.0f); return true;
-            case SDLK_RIGHT: rotate(step, 0.0f); return true;
-            case SDLK_UP: rotate(0.0f, step); return true;
-            case SDLK_DOWN: rotate(0.0f, -step); return true;
-            case SDLK_w: zoom(0.9f); return true;
-            case SDLK_s: zoom(1.0f / 0.9f); return true;
-            default: return false;
+            case SDLK_LEFT:
+                rotate(-step, 0.0f);
+                return true;
+            case SDLK_RIGHT:
+                rotate(step, 0.0f);
+                return true;
+            case SDLK_UP:
+                rotate(0.0f, step);
+                return true;
+            case SDLK_DOWN:
+                rotate(0.0f, -step);
+                return true;
+            case SDLK_w:
+                zoom(0.9f);
+                return true;
+            case SDLK_s:
+                zoom(1.0f / 0.9f);
+                return true;
+            default:
+                return false;
         }
     }
     void onDrag(float dx, float dy) { rotate(dx * 0.005f, -dy * 0.005f); }

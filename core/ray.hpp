@@ -21,7 +21,8 @@ struct RayT {
         if (!isFinite(d)) throw std::invalid_argument("ray direction is not finite");
         if (isZero(d)) throw std::invalid_argument("ray direction is zero");
         if (!isFinite(o)) throw std::invalid_argument("ray origin is not finite");
-        if (std::isnan(tMin) || std::isnan(tMax)) throw std::invalid_argument("ray interval is NaN");
+        if (std::isnan(tMin) || std::isnan(tMax))
+            throw std::invalid_argument("ray interval is NaN");
     }
 
     Vec3T<T> at(T t) const { return origin + t * direction; }

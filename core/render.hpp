@@ -16,8 +16,8 @@ namespace boxes {
 
 struct RayCounts {
     uint64_t primary = 0, shadow = 0, reflection = 0, refraction = 0;
-    uint64_t shadowSkipped = 0;      // shadow rays the scene analysis proved unnecessary
-    uint64_t lightsOutOfRange = 0;   // light evaluations beyond the light's radius
+    uint64_t shadowSkipped = 0;     // shadow rays the scene analysis proved unnecessary
+    uint64_t lightsOutOfRange = 0;  // light evaluations beyond the light's radius
     uint64_t total() const { return primary + shadow + reflection + refraction; }
     RayCounts& operator+=(const RayCounts& o);
 };

@@ -26,10 +26,14 @@ std::string cellText(const Cell& c) {
     if (std::isinf(v)) return v > 0 ? "inf" : "-inf";
     char buf[64];
     double a = std::abs(v);
-    if (v == 0.0) std::snprintf(buf, sizeof buf, "0");
-    else if (a >= 1e6 || a < 1e-3) std::snprintf(buf, sizeof buf, "%.3g", v);
-    else if (a >= 100) std::snprintf(buf, sizeof buf, "%.1f", v);
-    else std::snprintf(buf, sizeof buf, "%.4g", v);
+    if (v == 0.0)
+        std::snprintf(buf, sizeof buf, "0");
+    else if (a >= 1e6 || a < 1e-3)
+        std::snprintf(buf, sizeof buf, "%.3g", v);
+    else if (a >= 100)
+        std::snprintf(buf, sizeof buf, "%.1f", v);
+    else
+        std::snprintf(buf, sizeof buf, "%.4g", v);
     return buf;
 }
 
@@ -93,7 +97,8 @@ nlohmann::json Report::toJson() const {
     j["tables"] = nlohmann::json::array();
     for (const auto& t : tables) j["tables"].push_back(t.toJson());
     j["images"] = nlohmann::json::array();
-    for (const auto& [path, caption] : images) j["images"].push_back({{"path", path}, {"caption", caption}});
+    for (const auto& [path, caption] : images)
+        j["images"].push_back({{"path", path}, {"caption", caption}});
     j["facts"] = facts;
     j["plots"] = plots;
     return j;
@@ -113,10 +118,14 @@ void Report::write(std::ostream& out, const std::string& jsonPath) const {
 
 std::string formatSeconds(double s) {
     char buf[64];
-    if (s < 1e-6) std::snprintf(buf, sizeof buf, "%.2f ns", s * 1e9);
-    else if (s < 1e-3) std::snprintf(buf, sizeof buf, "%.2f us", s * 1e6);
-    else if (s < 1.0) std::snprintf(buf, sizeof buf, "%.2f ms", s * 1e3);
-    else std::snprintf(buf, sizeof buf, "%.2f s", s);
+    if (s < 1e-6)
+        std::snprintf(buf, sizeof buf, "%.2f ns", s * 1e9);
+    else if (s < 1e-3)
+        std::snprintf(buf, sizeof buf, "%.2f us", s * 1e6);
+    else if (s < 1.0)
+        std::snprintf(buf, sizeof buf, "%.2f ms", s * 1e3);
+    else
+        std::snprintf(buf, sizeof buf, "%.2f s", s);
     return buf;
 }
 

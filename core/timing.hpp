@@ -37,7 +37,6 @@ Timing measure(int repeats, const std::function<void()>& fn);
 
 // Times batches of calls: the batch size grows until one batch takes at least
 // minBatchSeconds, then `repeats` batches are timed. Reports seconds per call.
-Timing measureBatched(int repeats, const std::function<void()>& fn,
-                      double minBatchSeconds = 0.02);
+Timing measureBatched(int repeats, const std::function<void()>& fn, double minBatchSeconds = 0.02);
 
 }  // namespace boxes

@@ -26,13 +26,13 @@ namespace {
 // Runs a cleanup action when the scope ends, also while an exception unwinds.
 template <typename F>
 class Defer {
-  public:
+public:
     explicit Defer(F action) : action_(std::move(action)) {}
     ~Defer() { action_(); }
     Defer(const Defer&) = delete;
     Defer& operator=(const Defer&) = delete;
 
-  private:
+private:
     F action_;
 };
 
@@ -130,7 +130,7 @@ void main() {
 
 // The GL objects that draw the step's image letterboxed into the window.
 class ImageView {
-  public:
+public:
     explicit ImageView(const Gl& gl) : gl_(gl) {
         program_ = gl_.CreateProgram();
         GLuint vertex = compile(GL_VERTEX_SHADER, kVertexShader);
@@ -198,7 +198,7 @@ class ImageView {
         gl_.Viewport(0, 0, framebufferWidth, framebufferHeight);
     }
 
-  private:
+private:
     GLuint compile(GLenum type, const char* source) {
         GLuint shader = gl_.CreateShader(type);
         gl_.ShaderSource(shader, 1, &source, nullptr);

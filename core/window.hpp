@@ -19,7 +19,7 @@ struct KeyBinding {
 
 struct WindowOptions {
     std::string title = "Boxes";
-    int width = 960;   // window size in screen pixels; the image is scaled to fit
+    int width = 960;  // window size in screen pixels; the image is scaled to fit
     int height = 720;
     // Scripted runs for tests and CI: stop after this many frames (0: run until closed),
     // pressing scriptedKeys[i] (SDL key names such as "t", "Space", "F1") before frame i+1.

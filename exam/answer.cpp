@@ -75,7 +75,7 @@ std::vector<Token> tokenize(const std::string& s) {
 
 // Recursive descent over the tokens; `list` makes whitespace and signs separate numbers.
 class Parser {
-  public:
+public:
     Parser(std::vector<Token> tokens, bool list) : tokens_(std::move(tokens)), list_(list) {}
 
     std::vector<double> parseList() {
@@ -98,7 +98,7 @@ class Parser {
         return v;
     }
 
-  private:
+private:
     const Token& peek() const { return tokens_[pos_]; }
     bool isSymbol(const char* s) const { return peek().kind == Token::Symbol && peek().text == s; }
     // In a list at the outer level, " -2" (space before, none after) starts a new number.

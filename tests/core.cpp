@@ -55,7 +55,9 @@ TEST_SUITE("core") {
         CHECK_THROWS(compareImages(a, Image(1, 1)));
     }
     TEST_CASE("mesh: OBJ polygons are fan-triangulated in file order") {
-        Mesh m = parseObj("v 0 0 0\nv 1 0 0\nv 1 1 0\nv 0 1 0\nv 0 0 1\nf 1 2 3 4\nf 1/1/1 2/2/2 5/3/3\nf -1 -2 -3\n");
+        Mesh m = parseObj(
+            "v 0 0 0\nv 1 0 0\nv 1 1 0\nv 0 1 0\nv 0 0 1\nf 1 2 3 4\nf 1/1/1 2/2/2 5/3/3\nf -1 -2 "
+            "-3\n");
         REQUIRE(m.triangleCount() == 4);
         CHECK(m.triangles[0] == std::array<uint32_t, 3>{0, 1, 2});
         CHECK(m.triangles[1] == std::array<uint32_t, 3>{0, 2, 3});
@@ -75,11 +77,15 @@ TEST_SUITE("core") {
         };
         CHECK(message("").find("empty") != std::string::npos);
         CHECK(message("v 0 0 0\nv 1 0 0\n").find("no triangles") != std::string::npos);
-        CHECK(message("v 0 0 0\nv 1 zero 0\nv 0 1 0\nf 1 2 3\n").find("not a number") != std::string::npos);
+        CHECK(message("v 0 0 0\nv 1 zero 0\nv 0 1 0\nf 1 2 3\n").find("not a number") !=
+              std::string::npos);
         CHECK(message("v 0 0 0\nv 1 0 0\nv 0 1 0\nf 1 2 4\n").find("range") != std::string::npos);
-        CHECK(message("v 0 0 0\nv 1 0\nv 0 1 0\nf 1 2 3\n").find("3 coordinates") != std::string::npos);
-        CHECK(message("v 0 0 0\nv 1e39 0 0\nv 0 1 0\nf 1 2 3\n").find("range") != std::string::npos);
-        CHECK(message("v 0 0 0\nv nan 0 0\nv 0 1 0\nf 1 2 3\n").find("non-finite") != std::string::npos);
+        CHECK(message("v 0 0 0\nv 1 0\nv 0 1 0\nf 1 2 3\n").find("3 coordinates") !=
+              std::string::npos);
+        CHECK(message("v 0 0 0\nv 1e39 0 0\nv 0 1 0\nf 1 2 3\n").find("range") !=
+              std::string::npos);
+        CHECK(message("v 0 0 0\nv nan 0 0\nv 0 1 0\nf 1 2 3\n").find("non-finite") !=
+              std::string::npos);
         for (const std::string& m : {message(""), message("v 0 0 0\nv 1 0 0\nv 0 1 0\nf 1 2 9\n")})
             CHECK(m.find('\n') == std::string::npos);
         CHECK_THROWS_AS(loadObj("/nonexistent/file.obj"), InputError);
@@ -141,7 +147,8 @@ TEST_SUITE("core") {
 
 TEST_SUITE("renderer") {
     TEST_CASE("effects on demand: every scene kind renders the identical image with fewer rays") {
-        for (const char* name : {"spheres", "diffuse", "mirrors", "glass", "single-sphere", "small-lights"}) {
+        for (const char* name :
+             {"spheres", "diffuse", "mirrors", "glass", "single-sphere", "small-lights"}) {
             INFO(name);
             Scene scene = makeScene(name, SceneOptions{test::dataDir(), 4.0f / 3.0f});
             auto c = test::renderBothWays(scene, 40, 30, 4);

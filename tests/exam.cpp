@@ -35,7 +35,8 @@ TEST_SUITE("exam") {
         checkVec(s.bottomLeft, Vec3d(-2, -1, -1), 1e-12);
         checkVec(s.bottomRight, Vec3d(2, -1, -1), 1e-12);
     }
-    TEST_CASE("exam: screen corners from eye (1 1 1) looking along (1 0 1) with fov 60 and aspect 4/3") {
+    TEST_CASE(
+        "exam: screen corners from eye (1 1 1) looking along (1 0 1) with fov 60 and aspect 4/3") {
         Camerad c;
         c.eye = Vec3d(1, 1, 1);
         c.view = Vec3d(1, 0, 1);
@@ -101,7 +102,8 @@ TEST_SUITE("exam") {
         REQUIRE(t.has_value());
         CHECK(*t == 4.0);
         // Missing by a hair: the line x = 1.0000001 passes outside.
-        CHECK_FALSE(intersectSphere(Rayd({1.0000001, 0, 5}, {0, 0, -1}), SphereT<double>{{0, 0, 0}, 1.0}));
+        CHECK_FALSE(
+            intersectSphere(Rayd({1.0000001, 0, 5}, {0, 0, -1}), SphereT<double>{{0, 0, 0}, 1.0}));
     }
     TEST_CASE("exam: reflection direction") {
         Vec3d d = glm::normalize(Vec3d(1, -1, 0)), n(0, 1, 0);

@@ -8,7 +8,8 @@ using namespace boxes;
 TEST_SUITE("hard cases") {
     TEST_CASE("hard case: a ray with a zero or NaN direction is an error") {
         CHECK_THROWS_WITH_AS(Ray(Vec3(0), Vec3(0)), "ray direction is zero", std::invalid_argument);
-        CHECK_THROWS_WITH_AS(Ray(Vec3(0), Vec3(-0.0f, 0.0f, -0.0f)), "ray direction is zero", std::invalid_argument);
+        CHECK_THROWS_WITH_AS(Ray(Vec3(0), Vec3(-0.0f, 0.0f, -0.0f)), "ray direction is zero",
+                             std::invalid_argument);
         CHECK_THROWS_AS(Ray(Vec3(0), Vec3(std::nanf(""), 1, 0)), std::invalid_argument);
         CHECK_THROWS_AS(Rayd(Vec3d(0), Vec3d(1, INFINITY, 0)), std::invalid_argument);
         CHECK_NOTHROW(Ray(Vec3(0), Vec3(0, -0.0f, 1e-30f)));

@@ -76,11 +76,13 @@ TEST_SUITE("exercise 1.2") {
         CHECK_FALSE(rayPlaneDistance(Rayd({0, 0, 1}, {1, 0, 0}), z0).has_value());  // parallel
         CHECK_FALSE(rayPlaneDistance(Rayd({0, 0, 0}, {1, 1, 0}), z0).has_value());  // in plane
         // -x - z = 10 lies behind the eye: t = -6, negative, and still reported.
-        auto behind = rayPlaneDistance(Rayd({1, 1, 1}, {1, 0, 1}), PlaneT<double>{{-1, 0, -1}, -10});
+        auto behind =
+            rayPlaneDistance(Rayd({1, 1, 1}, {1, 0, 1}), PlaneT<double>{{-1, 0, -1}, -10});
         REQUIRE(behind.has_value());
         CHECK(*behind == doctest::Approx(-6.0));
         // Float, -0.0 in the direction: still parallel.
-        CHECK_FALSE(rayPlaneDistance(Ray({0, 0, 1}, {1, 0, -0.0f}), PlaneT<float>{{0, 0, 1}, 0}).has_value());
+        CHECK_FALSE(rayPlaneDistance(Ray({0, 0, 1}, {1, 0, -0.0f}), PlaneT<float>{{0, 0, 1}, 0})
+                        .has_value());
     }
 }
 
@@ -98,7 +100,9 @@ TEST_SUITE("exercise 1.3") {
         CHECK_FALSE(insideEdgePlanes(Rayd({1, 1, 1}, {0, 0, -1}), kUnit).has_value());
         CHECK_FALSE(insideEdgePlanes(Rayd({-0.1, 0.5, 1}, {0, 0, -1}), kUnit).has_value());
     }
-    TEST_CASE("hard case: the inside test accepts a ray through a shared edge in one of the two triangles") {
+    TEST_CASE(
+        "hard case: the inside test accepts a ray through a shared edge in one of the two "
+        "triangles") {
         // The two triangles compute the same edge volume with opposite signs, so in float
         // a ray aimed at the shared edge is inside one of them (or both), never neither.
         std::mt19937_64 rng(13);
@@ -136,9 +140,11 @@ void checkWorkedHits(TriangleTest test) {
     const auto tri = cast<Real>(kUnit);
     CHECK_FALSE(intersectTriangle(test, RayT<Real>({1, 1, 2}, {0, 0, -1}), tri));
     CHECK_FALSE(intersectTriangle(test, RayT<Real>({Real(0.2), Real(0.2), -1}, {0, 0, -1}), tri));
-    CHECK_FALSE(intersectTriangle(test, RayT<Real>({Real(0.2), Real(0.2), 2}, {0, 0, -1}, 0, Real(1.5)), tri));
+    CHECK_FALSE(intersectTriangle(
+        test, RayT<Real>({Real(0.2), Real(0.2), 2}, {0, 0, -1}, 0, Real(1.5)), tri));
     // Closed interval: a hit exactly at tmax counts.
-    CHECK(intersectTriangle(test, RayT<Real>({Real(0.25), Real(0.25), 2}, {0, 0, -1}, 0, Real(2)), tri));
+    CHECK(intersectTriangle(test, RayT<Real>({Real(0.25), Real(0.25), 2}, {0, 0, -1}, 0, Real(2)),
+                            tri));
 }
 
 // Hard cases every full test must pass; `exact` tests must also close every crack.
@@ -156,7 +162,8 @@ void checkHardCases(TriangleTest test) {
     SUBCASE("hard case: a ray parallel to the plane, and one inside it, miss") {
         CHECK_FALSE(intersectTriangle(test, Rayd({0.2, 0.2, 1}, {1, 0, 0}), kUnit));
         CHECK_FALSE(intersectTriangle(test, Rayd({-1, 0.25, 0}, {1, 0, 0}), kUnit));
-        CHECK_FALSE(intersectTriangle(test, Ray({-1, 0.25f, 0}, {1, 0, -0.0f}), cast<float>(kUnit)));
+        CHECK_FALSE(
+            intersectTriangle(test, Ray({-1, 0.25f, 0}, {1, 0, -0.0f}), cast<float>(kUnit)));
     }
     SUBCASE("hard case: the scene scaled by 2^k, k in [-20, 20], keeps its hits") {
         std::mt19937_64 rng(7);
@@ -168,7 +175,8 @@ void checkHardCases(TriangleTest test) {
             auto h0 = intersectTriangle(test, base, cast<float>(kDiagonal));
             for (int k = -20; k <= 20; ++k) {
                 float s = std::ldexp(1.0f, k);
-                Triangle t{cast<float>(kDiagonal).a * s, cast<float>(kDiagonal).b * s, cast<float>(kDiagonal).c * s};
+                Triangle t{cast<float>(kDiagonal).a * s, cast<float>(kDiagonal).b * s,
+                           cast<float>(kDiagonal).c * s};
                 auto h = intersectTriangle(test, Ray(base.origin * s, base.direction), t);
                 INFO("k = " << k);
                 REQUIRE(h.has_value() == h0.has_value());
@@ -195,7 +203,9 @@ TEST_SUITE("plane test combined") {
         checkWorkedHits<float>(TriangleTest::PlaneTest);
         checkWorkedHits<double>(TriangleTest::PlaneTest);
     }
-    TEST_CASE("plane test: hard cases") { checkHardCases(TriangleTest::PlaneTest); }
+    TEST_CASE("plane test: hard cases") {
+        checkHardCases(TriangleTest::PlaneTest);
+    }
 }
 
 TEST_SUITE("exercise 1.4") {
@@ -203,7 +213,9 @@ TEST_SUITE("exercise 1.4") {
         checkWorkedHits<float>(TriangleTest::MollerTrumbore);
         checkWorkedHits<double>(TriangleTest::MollerTrumbore);
     }
-    TEST_CASE("Moller-Trumbore: hard cases") { checkHardCases(TriangleTest::MollerTrumbore); }
+    TEST_CASE("Moller-Trumbore: hard cases") {
+        checkHardCases(TriangleTest::MollerTrumbore);
+    }
 }
 
 TEST_SUITE("exercise 1.5") {
@@ -211,7 +223,9 @@ TEST_SUITE("exercise 1.5") {
         checkWorkedHits<float>(TriangleTest::Watertight);
         checkWorkedHits<double>(TriangleTest::Watertight);
     }
-    TEST_CASE("watertight: hard cases") { checkHardCases(TriangleTest::Watertight); }
+    TEST_CASE("watertight: hard cases") {
+        checkHardCases(TriangleTest::Watertight);
+    }
 
     TEST_CASE("hard case: a ray through a shared edge hits at least one of the two triangles") {
         // Rays at float points along the shared hypotenuse, from many directions.
@@ -292,16 +306,18 @@ TEST_SUITE("program 01") {
 
     TEST_CASE("headless render writes a PNG of the requested size") {
         test::TempDir dir;
-        auto run = test::runProgram(program, "--headless --scene sh1 --width 64 --height 40 --out a.png", dir);
+        auto run = test::runProgram(
+            program, "--headless --scene sh1 --width 64 --height 40 --out a.png", dir);
         INFO(run.err);
         REQUIRE(run.exitCode == 0);
         CHECK(test::pngSize(dir.file("a.png")) == std::pair{64, 40});
     }
     TEST_CASE("measurements: the JSON report has the speed and crack tables") {
         test::TempDir dir;
-        auto run = test::runProgram(
-            program, "--headless --scene sh1 --width 32 --height 24 --out a.png --measure --crack-rays 2000 --report r.json",
-            dir);
+        auto run = test::runProgram(program,
+                                    "--headless --scene sh1 --width 32 --height 24 --out a.png "
+                                    "--measure --crack-rays 2000 --report r.json",
+                                    dir);
         INFO(run.err);
         REQUIRE(run.exitCode == 0);
         std::string json = test::readText(dir.file("r.json"));
@@ -312,10 +328,11 @@ TEST_SUITE("program 01") {
     }
     TEST_CASE("window: scripted frames with key presses under the offscreen video driver") {
         test::TempDir dir;
-        auto run = test::runProgram(program,
-                                    "--scene sh1 --width 64 --height 48 --frames 4 --keys t,m,t,Left "
-                                    "--screenshot shot.png",
-                                    dir, test::kWindowEnvironment);
+        auto run =
+            test::runProgram(program,
+                             "--scene sh1 --width 64 --height 48 --frames 4 --keys t,m,t,Left "
+                             "--screenshot shot.png",
+                             dir, test::kWindowEnvironment);
         INFO(run.err);
         REQUIRE(run.exitCode == 0);
         CHECK(test::pngSize(dir.file("shot.png")).first > 0);
@@ -329,17 +346,17 @@ TEST_SUITE("program 01") {
             std::string args, expect;
             int code;
         };
-        for (const Case& c : std::vector<Case>{
-                 {"--scene missing.obj", "no such file", 1},
-                 {"--scene letters.obj", "not a number", 1},
-                 {"--scene range.obj", "out of range", 1},
-                 {"--scene empty.obj", "empty", 1},
-                 {"--scene nosuchscene", "unknown scene", 1},
-                 {"--frobnicate", "frobnicate", 2},
-                 {"--width 0", "width", 2},
-                 {"--eye 1,2,3 --look 1,2,3", "view direction is zero", 1},
-                 {"--up 0,0,0", "up vector is zero", 1},
-                 {"--eye 1,2", "expected X,Y,Z", 1}}) {
+        for (const Case& c :
+             std::vector<Case>{{"--scene missing.obj", "no such file", 1},
+                               {"--scene letters.obj", "not a number", 1},
+                               {"--scene range.obj", "out of range", 1},
+                               {"--scene empty.obj", "empty", 1},
+                               {"--scene nosuchscene", "unknown scene", 1},
+                               {"--frobnicate", "frobnicate", 2},
+                               {"--width 0", "width", 2},
+                               {"--eye 1,2,3 --look 1,2,3", "view direction is zero", 1},
+                               {"--up 0,0,0", "up vector is zero", 1},
+                               {"--eye 1,2", "expected X,Y,Z", 1}}) {
             INFO(c.args);
             auto run = test::runProgram(program, "--headless --out bad.png " + c.args, dir);
             CHECK(run.exitCode == c.code);

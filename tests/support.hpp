@@ -15,13 +15,16 @@
 
 namespace boxes::test {
 
-inline std::string dataDir() { return BOXES_TEST_DATA; }
+inline std::string dataDir() {
+    return BOXES_TEST_DATA;
+}
 
 // A fresh folder under the system's temporary directory, removed at scope exit.
 struct TempDir {
     std::filesystem::path path;
     TempDir() {
-        std::string pattern = (std::filesystem::temp_directory_path() / "boxes-test-XXXXXX").string();
+        std::string pattern =
+            (std::filesystem::temp_directory_path() / "boxes-test-XXXXXX").string();
         path = mkdtemp(pattern.data());
     }
     ~TempDir() {
@@ -95,7 +98,8 @@ struct EffectsComparison {
     RayCounts lean, forced;
     bool identical = false;
 };
-inline EffectsComparison renderBothWays(const Scene& scene, int width, int height, int maxDepth = 5) {
+inline EffectsComparison renderBothWays(const Scene& scene, int width, int height,
+                                        int maxDepth = 5) {
     RenderSettings s;
     s.width = width;
     s.height = height;

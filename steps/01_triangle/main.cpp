@@ -18,7 +18,8 @@ using namespace boxes;
 namespace {
 
 // Pixels where the three tests see different nearest triangles, drawn in magenta.
-size_t markDisagreements(const TriangleGrid& grid, const Camera& camera, Image& image, int threads) {
+size_t markDisagreements(const TriangleGrid& grid, const Camera& camera, Image& image,
+                         int threads) {
     std::vector<size_t> perRow(size_t(image.height()), 0);
     CameraBasisT<float> basis = camera.basis();
     parallelRows(image.height(), threads, [&](int y, int) {
@@ -49,7 +50,8 @@ TriangleTest parseTest(const std::string& name) {
 Table accuracyVersusTime(const Table& speed, const Table& cracks) {
     Table t;
     t.id = "accuracy_vs_time";
-    t.title = "Accuracy against time: each test's speed beside its cracks (all meshes and placements)";
+    t.title =
+        "Accuracy against time: each test's speed beside its cracks (all meshes and placements)";
     t.columns = {"variant", "ns/test", "cracks /1M"};
     t.note = "ns/test from the speed table; cracks per million over every crack ray";
     for (size_t i = 0; i < speed.rows.size(); ++i) {
@@ -68,7 +70,8 @@ Table accuracyVersusTime(const Table& speed, const Table& cracks) {
 }
 
 std::string withSuffix(const std::string& png, const std::string& suffix) {
-    std::string stem = png.size() > 4 && png.ends_with(".png") ? png.substr(0, png.size() - 4) : png;
+    std::string stem =
+        png.size() > 4 && png.ends_with(".png") ? png.substr(0, png.size() - 4) : png;
     return stem + suffix + ".png";
 }
 
@@ -76,8 +79,9 @@ std::string withSuffix(const std::string& png, const std::string& suffix) {
 
 int main(int argc, char** argv) {
     return runMain("01_triangle", [&] {
-        CLI::App app{"Step 01: ray/triangle intersection: the plane test, Moller-Trumbore and the "
-                     "watertight test, side by side."};
+        CLI::App app{
+            "Step 01: ray/triangle intersection: the plane test, Moller-Trumbore and the "
+            "watertight test, side by side."};
         CommonOptions opts;
         addCommonOptions(app, opts, "bunny");
         std::string testName = "watertight";
@@ -94,7 +98,8 @@ int main(int argc, char** argv) {
         Scene scene = sceneFromOptions(opts);
         std::shared_ptr<TriangleGrid> grid;
         if (scene.hasMesh()) {
-            grid = std::make_shared<TriangleGrid>(scene.mesh, scene.meshMaterial, parseTest(testName));
+            grid =
+                std::make_shared<TriangleGrid>(scene.mesh, scene.meshMaterial, parseTest(testName));
             scene.geometries.push_back(grid);
         }
         RenderSettings settings;
@@ -125,13 +130,15 @@ int main(int argc, char** argv) {
                 std::string disagreePath = withSuffix(out, "-disagree");
                 marked.writePng(disagreePath);
                 report.images.push_back(
-                    {disagreePath, "magenta: pixels where the three tests pick different triangles"});
+                    {disagreePath,
+                     "magenta: pixels where the three tests pick different triangles"});
                 report.facts["pixels_disagreeing"] = differ;
                 std::cerr << "01_triangle: measuring speed...\n";
                 report.add(measureTriangleSpeed(scene.mesh, opts.seed, 7));
                 std::cerr << "01_triangle: counting cracks...\n";
                 Mesh sh1 = loadObj(opts.dataDir + "/meshes/sh1.obj");
-                Mesh bunny = scene.name == "bunny" ? scene.mesh : loadObj(opts.dataDir + "/meshes/bunny.obj");
+                Mesh bunny = scene.name == "bunny" ? scene.mesh
+                                                   : loadObj(opts.dataDir + "/meshes/bunny.obj");
                 Vec3 far(1000.0f, -700.0f, 300.0f);
                 report.add(measureCracks({{"bunny", &bunny, Vec3(0.0f)},
                                           {"bunny", &bunny, far},
@@ -144,8 +151,9 @@ int main(int argc, char** argv) {
                                         {"y", "cracks /1M"},
                                         {"series", "variant"},
                                         {"logy", true},
-                                        {"title", "Accuracy against time: cracks per million rays "
-                                                  "aimed at shared edges and vertices"}});
+                                        {"title",
+                                         "Accuracy against time: cracks per million rays "
+                                         "aimed at shared edges and vertices"}});
             }
             report.write(opts.json ? std::cerr : std::cout, opts.json ? "-" : opts.reportPath);
             if (opts.json && !opts.reportPath.empty()) report.write(std::cerr, opts.reportPath);
@@ -186,7 +194,8 @@ int main(int argc, char** argv) {
                 if (grid) grid->setTest(test);
                 Stopwatch watch;
                 image = renderImage(scene, orbit.camera(), settings);
-                if (marks && grid) differ = markDisagreements(*grid, orbit.camera(), image, opts.threads);
+                if (marks && grid)
+                    differ = markDisagreements(*grid, orbit.camera(), image, opts.threads);
                 renderMs = watch.milliseconds();
                 dirty = false;
             }

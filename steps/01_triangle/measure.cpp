@@ -21,7 +21,6 @@ Vec3 randomInCone(std::mt19937_64& rng, Vec3 axis, float cosMax) {
     return cosTheta * axis + sinTheta * (std::cos(phi) * b1 + std::sin(phi) * b2);
 }
 
-
 }  // namespace
 
 CrackRaySet makeCrackRays(const Mesh& mesh, size_t edgeRays, size_t vertexRays, uint64_t seed,
@@ -65,7 +64,8 @@ CrackRaySet makeCrackRays(const Mesh& mesh, size_t edgeRays, size_t vertexRays, 
         for (int attempt = 0; attempt < 8; ++attempt) {
             dir = randomInCone(rng, glm::normalize(sum), cos60);
             bool front = true;
-            for (uint32_t t : tris) front = front && glm::dot(dir, glm::normalize(faceNormal(t))) >= 0.2f;
+            for (uint32_t t : tris)
+                front = front && glm::dot(dir, glm::normalize(faceNormal(t))) >= 0.2f;
             if (front) return true;
         }
         return false;
@@ -105,7 +105,8 @@ size_t countCracks(const Mesh& mesh, const std::vector<CrackRay>& rays, Triangle
         for (uint32_t t : r.triangles) {
             // The translated mesh is rounded to float first: that is the mesh a float
             // renderer holds, and the double test sees the same vertices.
-            TriangleT<T> tri{Vec3T<T>(mesh.vertex(t, 0) + offset), Vec3T<T>(mesh.vertex(t, 1) + offset),
+            TriangleT<T> tri{Vec3T<T>(mesh.vertex(t, 0) + offset),
+                             Vec3T<T>(mesh.vertex(t, 1) + offset),
                              Vec3T<T>(mesh.vertex(t, 2) + offset)};
             if (intersectTriangle(test, ray, tri)) {
                 hit = true;
@@ -122,13 +123,15 @@ template size_t countCracks<double>(const Mesh&, const std::vector<CrackRay>&, T
 Table measureCracks(const std::vector<CrackCase>& cases, size_t raysPerFeature, uint64_t seed) {
     Table table;
     table.id = "cracks";
-    table.title = "Cracks: rays aimed exactly at shared edges and vertices that no triangle there reports";
+    table.title =
+        "Cracks: rays aimed exactly at shared edges and vertices that no triangle there reports";
     table.columns = {"mesh", "placement", "feature", "rays"};
     for (TriangleTest test : kAllTriangleTests)
         for (const char* p : {"float", "double"})
             table.columns.push_back(std::string(triangleTestName(test)) + " " + p + " /1M");
-    table.note = "closed meshes; rays from outside, every target triangle facing the ray; "
-                 "cracks per million rays; offset = mesh translated by (1000,-700,300) in float";
+    table.note =
+        "closed meshes; rays from outside, every target triangle facing the ray; "
+        "cracks per million rays; offset = mesh translated by (1000,-700,300) in float";
     for (const CrackCase& c : cases) {
         CrackRaySet set = makeCrackRays(*c.data, raysPerFeature, raysPerFeature, seed, c.offset);
         bool far = c.offset != Vec3(0.0f);

@@ -122,18 +122,21 @@ Vec3 interpolateNormal(const Vec3& na, const Vec3& nb, const Vec3& nc, float u, 
 
 const char* triangleTestName(TriangleTest test) {
     switch (test) {
-        case TriangleTest::PlaneTest: return "plane test";
-        case TriangleTest::MollerTrumbore: return "Moller-Trumbore";
-        default: return "watertight";
+        case TriangleTest::PlaneTest:
+            return "plane test";
+        case TriangleTest::MollerTrumbore:
+            return "Moller-Trumbore";
+        default:
+            return "watertight";
     }
 }
 
-#define BOXES_INSTANTIATE(T)                                                                  \
-    template std::optional<PlaneT<T>> trianglePlane(const TriangleT<T>&);                    \
-    template std::optional<T> rayPlaneDistance(const RayT<T>&, const PlaneT<T>&);             \
+#define BOXES_INSTANTIATE(T)                                                                      \
+    template std::optional<PlaneT<T>> trianglePlane(const TriangleT<T>&);                         \
+    template std::optional<T> rayPlaneDistance(const RayT<T>&, const PlaneT<T>&);                 \
     template std::optional<glm::vec<2, T>> insideEdgePlanes(const RayT<T>&, const TriangleT<T>&); \
-    template std::optional<TriangleHit<T>> intersectMollerTrumbore(const RayT<T>&,            \
-                                                                   const TriangleT<T>&);      \
+    template std::optional<TriangleHit<T>> intersectMollerTrumbore(const RayT<T>&,                \
+                                                                   const TriangleT<T>&);          \
     template std::optional<TriangleHit<T>> intersectWatertight(const RayT<T>&, const TriangleT<T>&);
 BOXES_INSTANTIATE(float)
 BOXES_INSTANTIATE(double)

@@ -70,9 +70,12 @@ template <typename T>
 std::optional<TriangleHit<T>> intersectTriangle(TriangleTest test, const RayT<T>& ray,
                                                 const TriangleT<T>& tri) {
     switch (test) {
-        case TriangleTest::PlaneTest: return intersectPlaneTest(ray, tri);
-        case TriangleTest::MollerTrumbore: return intersectMollerTrumbore(ray, tri);
-        default: return intersectWatertight(ray, tri);
+        case TriangleTest::PlaneTest:
+            return intersectPlaneTest(ray, tri);
+        case TriangleTest::MollerTrumbore:
+            return intersectMollerTrumbore(ray, tri);
+        default:
+            return intersectWatertight(ray, tri);
     }
 }
 

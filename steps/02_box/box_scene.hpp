@@ -20,7 +20,7 @@ struct SceneBox {
 // A set of boxes the renderer sees as one Geometry; every ray tests every box with the
 // selected method (six planes: exercises 2.1 and 2.2; slabs: exercise 2.4).
 class BoxSet : public Geometry {
-  public:
+public:
     // Throws std::invalid_argument for an invalid box (OrientedBoxT::validate).
     explicit BoxSet(std::vector<SceneBox> boxes, BoxMethod method = BoxMethod::Slabs);
 
@@ -43,7 +43,7 @@ class BoxSet : public Geometry {
     Nearest nearest(const Ray& ray, BoxMethod method) const;
     const std::vector<SceneBox>& boxes() const { return boxes_; }
 
-  private:
+private:
     std::vector<SceneBox> boxes_;
     std::vector<std::array<Plane, 6>> planes_;  // filled when six planes are first used
     BoxMethod method_;

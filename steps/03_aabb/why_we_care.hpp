@@ -23,7 +23,7 @@ struct TestCounts {
 
 // Spheres, each with its box (exercise 3.1) tested first when the pre-test is on.
 class SphereCloud : public Geometry {
-  public:
+public:
     SphereCloud(std::vector<SceneSphere> spheres, std::shared_ptr<TestCounts> counts);
     void setPretest(bool on) { pretest_ = on; }
 
@@ -34,7 +34,7 @@ class SphereCloud : public Geometry {
     std::vector<int> materialsUsed() const override;
     size_t size() const { return spheres_.size(); }
 
-  private:
+private:
     std::vector<SceneSphere> spheres_;
     std::vector<Bounds3f> bounds_;
     Bounds3f all_;
@@ -49,7 +49,7 @@ class SphereCloud : public Geometry {
 // so a group's box is small. The boxes use the conservative slab test (exercise 3.7), so
 // the image is the same with and without the pre-test.
 class TriangleGroups : public Geometry {
-  public:
+public:
     TriangleGroups(const Mesh& mesh, int material, std::shared_ptr<TestCounts> counts,
                    int groupSize = 8);
     void setPretest(bool on) { pretest_ = on; }
@@ -62,7 +62,7 @@ class TriangleGroups : public Geometry {
     size_t size() const { return order_.size(); }
     size_t groups() const { return groupBoxes_.size(); }
 
-  private:
+private:
     Mesh mesh_;
     int material_;
     std::vector<uint32_t> order_;  // triangle indices, Morton order

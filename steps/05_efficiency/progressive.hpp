@@ -21,7 +21,7 @@ Clock steadyClock();
 using LineRenderer = std::function<void(Image& image, int row)>;
 
 class IncrementalRenderer {
-  public:
+public:
     IncrementalRenderer(int width, int height, LineRenderer renderLine, Clock clock);
 
     // Starts over from the first line (the camera moved). The rows not refined yet show
@@ -37,7 +37,7 @@ class IncrementalRenderer {
     double secondsPerLine() const { return lastLineSeconds_; }
     const Image& image() const { return image_; }
 
-  private:
+private:
     Image image_;
     LineRenderer renderLine_;
     Clock clock_;
@@ -48,7 +48,7 @@ class IncrementalRenderer {
 // Chooses the resolution scale (of width and height) that holds a target frame time
 // while the camera moves. The cost of a frame grows with its pixel count, scale^2.
 class AdaptiveResolution {
-  public:
+public:
     explicit AdaptiveResolution(double targetSeconds, float minScale = 0.125f,
                                 float maxScale = 1.0f);
     float scale() const { return scale_; }
@@ -56,7 +56,7 @@ class AdaptiveResolution {
     // Exercise 5.10: after a frame at scale() took frameSeconds, choose the next scale.
     void update(double frameSeconds);
 
-  private:
+private:
     double target_;
     float minScale_, maxScale_;
     float scale_;

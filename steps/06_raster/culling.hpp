@@ -23,7 +23,7 @@ struct CullStats {
 };
 
 class FrustumCuller {
-  public:
+public:
     // Builds the hierarchy over the mesh (step 04's binned SAH).
     explicit FrustumCuller(const Mesh& mesh);
 
@@ -33,7 +33,7 @@ class FrustumCuller {
                                            CullTest test, CullStats& stats) const;
     const Bvh& bvh() const { return bvh_; }
 
-  private:
+private:
     Bvh bvh_;
 };
 

@@ -631,14 +631,8 @@ TEST_SUITE("program 06") {
 
     TEST_CASE("headless render writes a PNG and the ids and depth buffers") {
         test::TempDir dir;
-        auto run = test::runProgram(
-            program,
-            "--headless --scene sh1 --width 64 --height 40 --out a.png --ids a.ids "
-            "--depth a.depth --json",
-            dir);
-        INFO(run.err);
-        REQUIRE(run.exitCode == 0);
-        CHECK(test::pngSize(dir.file("a.png")) == std::pair{64, 40});
+        auto run = test::runHeadless(program, dir, 64, 40,
+                                     "--scene sh1 --ids a.ids --depth a.depth --json");
         std::string ids = test::readText(dir.file("a.ids")),
                     depth = test::readText(dir.file("a.depth"));
         REQUIRE(ids.size() == 64 * 40 * 4);
@@ -663,69 +657,38 @@ TEST_SUITE("program 06") {
     }
     TEST_CASE("compare mode prints the agreement and writes the difference image") {
         test::TempDir dir;
-        auto run = test::runProgram(
-            program, "--headless --scene sh1 --width 64 --height 48 --out a.png --compare", dir);
-        INFO(run.err);
-        REQUIRE(run.exitCode == 0);
+        auto run = test::runHeadless(program, dir, 64, 48, "--scene sh1 --compare");
         CHECK(run.out.find("same triangle:") != std::string::npos);
         CHECK(test::pngSize(dir.file("a-diff.png")) == std::pair{64, 48});
     }
     TEST_CASE("measurements: the JSON report has the step's tables") {
         test::TempDir dir;
-        auto run = test::runProgram(
-            program, "--headless --width 48 --height 36 --out a.png --measure --report r.json",
-            dir);
-        INFO(run.err);
-        REQUIRE(run.exitCode == 0);
-        std::string json = test::readText(dir.file("r.json"));
-        for (const char* id : {"\"visibility\"", "\"frame_time\"", "\"shadow_bias\"", "\"shadows\"",
-                               "\"interpolation\"", "\"culling\""})
-            CHECK(json.find(id) != std::string::npos);
+        test::runHeadless(program, dir, 48, 36, "--measure --report r.json");
+        test::checkReportTables(dir.file("r.json"), {"visibility", "frame_time", "shadow_bias",
+                                                     "shadows", "interpolation", "culling"});
         CHECK(test::pngSize(dir.file("a-affine.png")) == std::pair{48, 36});
     }
     TEST_CASE("window: scripted frames with key presses under the offscreen video driver") {
         test::TempDir dir;
-        auto run = test::runProgram(
-            program,
-            "--scene sh1 --width 64 --height 48 --frames 8 --keys r,d,h,b,p,f,Left "
-            "--screenshot shot.png",
-            dir, test::kWindowEnvironment);
-        INFO(run.err);
-        REQUIRE(run.exitCode == 0);
-        CHECK(test::pngSize(dir.file("shot.png")).first > 0);
+        test::runWindowScript(program, dir, "--scene sh1 --width 64 --height 48", 8,
+                              "r,d,h,b,p,f,Left");
     }
     TEST_CASE("bad input: one clear line and a non-zero exit") {
         test::TempDir dir;
         std::ofstream(dir.file("nan.obj")) << "v 0 0 0\nv 1 nan 0\nv 0 1 0\nf 1 2 3\n";
-        struct Case {
-            std::string args, expect;
-            int code;
-        };
-        for (const Case& c : std::vector<Case>{
-                 {"--scene sh1 --eye 1,2,3 --look 1,2,3", "view direction is zero", 1},
-                 {"--scene sh1 --near 0", "--near", 1},
-                 {"--scene sh1 --near -2", "--near", 1},
-                 {"--scene sh1 --near 2 --far 1", "--far", 1},
-                 {"--scene sh1 --width 0", "width", 2},
-                 {"--scene sh1 --height 0", "height", 2},
-                 {"--scene nan.obj", "non-finite", 1},
-                 {"--scene sh1 --shadows sometimes", "shadows", 2}}) {
-            INFO(c.args);
-            auto run = test::runProgram(program, "--headless --out bad.png " + c.args, dir);
-            CHECK(run.exitCode == c.code);
-            CHECK(test::lineCount(run.err) == 1);
-            CHECK(run.err.find(c.expect) != std::string::npos);
-            CHECK_FALSE(std::filesystem::exists(dir.file("bad.png")));
-        }
+        test::checkBadInput(program, dir,
+                            {{"--scene sh1 --eye 1,2,3 --look 1,2,3", "view direction is zero", 1},
+                             {"--scene sh1 --near 0", "--near", 1},
+                             {"--scene sh1 --near -2", "--near", 1},
+                             {"--scene sh1 --near 2 --far 1", "--far", 1},
+                             {"--scene sh1 --width 0", "width", 2},
+                             {"--scene sh1 --height 0", "height", 2},
+                             {"--scene nan.obj", "non-finite", 1},
+                             {"--scene sh1 --shadows sometimes", "shadows", 2}});
     }
     TEST_CASE("a view parallel to up renders") {
         test::TempDir dir;
-        auto run = test::runProgram(program,
-                                    "--headless --scene sh1 --width 32 --height 24 --out a.png "
-                                    "--eye 176,100,-112 --look 176,0,-112 --up 0,1,0",
-                                    dir);
-        INFO(run.err);
-        REQUIRE(run.exitCode == 0);
-        CHECK(test::pngSize(dir.file("a.png")) == std::pair{32, 24});
+        test::runHeadless(program, dir, 32, 24,
+                          "--scene sh1 --eye 176,100,-112 --look 176,0,-112 --up 0,1,0");
     }
 }

@@ -19,16 +19,6 @@ using boxes::test::checkVec;
 
 namespace {
 
-Camera makeCamera(Vec3 eye, Vec3 look, Vec3 up, float fov, float aspect) {
-    Camera c;
-    c.eye = eye;
-    c.view = look - eye;
-    c.up = up;
-    c.fovYDegrees = fov;
-    c.aspect = aspect;
-    return c;
-}
-
 // Test-local fill-rule rasterizer: our own exact edge function, the student's top-left rule.
 int64_t localEdge(FixedPoint2 a, FixedPoint2 b, FixedPoint2 p) {
     return (b.x - a.x) * (p.y - a.y) - (b.y - a.y) * (p.x - a.x);
@@ -120,7 +110,7 @@ void checkAgreement(const Agreement& a, double minimum) {
 TEST_SUITE("exercise 6.1") {
     TEST_CASE("a point through view and clip space") {
         // Eye (0,0,5) looking down -z, fov 90 (f = 1), aspect 2, near 1, far 11.
-        Camera c = makeCamera(Vec3(0, 0, 5), Vec3(0, 0, 0), Vec3(0, 1, 0), 90.0f, 2.0f);
+        Camera c = Camera::lookingAt(Vec3(0, 0, 5), Vec3(0, 0, 0), Vec3(0, 1, 0), 90.0f, 2.0f);
         Vec4d view = viewMatrix(c) * Vec4d(1.0, 0.5, 0.0, 1.0);
         checkVec(view, Vec4d(1.0, 0.5, -5.0, 1.0), 1e-12);
         CHECK(view.w == doctest::Approx(1.0));
@@ -135,8 +125,8 @@ TEST_SUITE("exercise 6.1") {
         CHECK(far.z / far.w == doctest::Approx(1.0));
     }
     TEST_CASE("pixel centres land where the ray tracer's primary rays go") {
-        Camera c =
-            makeCamera(Vec3(0.3f, 1.2f, 4.0f), Vec3(-0.2f, 0.1f, 0.0f), Vec3(0, 1, 0), 50.0f, 1.5f);
+        Camera c = Camera::lookingAt(Vec3(0.3f, 1.2f, 4.0f), Vec3(-0.2f, 0.1f, 0.0f), Vec3(0, 1, 0),
+                                     50.0f, 1.5f);
         const int w = 90, h = 60;
         Mat4d m = projectionMatrix(c, 0.01, 100.0) * viewMatrix(c);
         for (auto [x, y] : {std::pair{0, 0}, {89, 59}, {45, 30}, {3, 57}}) {
@@ -150,7 +140,7 @@ TEST_SUITE("exercise 6.1") {
         }
     }
     TEST_CASE("hard case: view parallel to up gives a finite view matrix") {
-        Camera c = makeCamera(Vec3(0, 5, 0), Vec3(0, 0, 0), Vec3(0, 1, 0), 60.0f, 1.0f);
+        Camera c = Camera::lookingAt(Vec3(0, 5, 0), Vec3(0, 0, 0), Vec3(0, 1, 0), 60.0f, 1.0f);
         Mat4d v = viewMatrix(c);
         for (int i = 0; i < 4; ++i)
             for (int j = 0; j < 4; ++j) CHECK(std::isfinite(v[i][j]));
@@ -398,10 +388,11 @@ TEST_SUITE("raster vs ray tracer") {
     TEST_CASE("generated scenes from several views agree on at least 99.5 percent") {
         Scene s = generatedScene(7);
         for (const Camera& c :
-             {makeCamera(Vec3(0, 2.5f, 4), Vec3(0, 0, 0), Vec3(0, 1, 0), 50.0f, 4.0f / 3.0f),
-              makeCamera(Vec3(-3, 0.7f, 0.2f), Vec3(2, 0.2f, 0), Vec3(0, 1, 0), 70.0f, 4.0f / 3.0f),
-              makeCamera(Vec3(0.1f, 0.4f, 0.1f), Vec3(1, 0.3f, 1), Vec3(0, 1, 0), 90.0f,
-                         4.0f / 3.0f)}) {
+             {Camera::lookingAt(Vec3(0, 2.5f, 4), Vec3(0, 0, 0), Vec3(0, 1, 0), 50.0f, 4.0f / 3.0f),
+              Camera::lookingAt(Vec3(-3, 0.7f, 0.2f), Vec3(2, 0.2f, 0), Vec3(0, 1, 0), 70.0f,
+                                4.0f / 3.0f),
+              Camera::lookingAt(Vec3(0.1f, 0.4f, 0.1f), Vec3(1, 0.3f, 1), Vec3(0, 1, 0), 90.0f,
+                                4.0f / 3.0f)}) {
             Agreement a = agreementOf(s, c, 160, 120);
             CHECK(a.visibility.coveredEither > 1000);
             checkAgreement(a, 0.995);
@@ -423,8 +414,8 @@ TEST_SUITE("raster vs ray tracer") {
         }
         Scene s = makeScene(shared + "/oa_thor.obj", {test::dataDir(), 4.0f / 3.0f});
         attachGrid(s);
-        Camera c =
-            makeCamera(Vec3(960, -384, 2), Vec3(960, 600, 2), Vec3(0, 0, 1), 90.0f, 4.0f / 3.0f);
+        Camera c = Camera::lookingAt(Vec3(960, -384, 2), Vec3(960, 600, 2), Vec3(0, 0, 1), 90.0f,
+                                     4.0f / 3.0f);
         Agreement a = agreementOf(s, c, 200, 150);
         checkAgreement(a, 0.995);
         // Most of the map lies behind the eye or crosses the near plane.
@@ -454,7 +445,7 @@ TEST_SUITE("raster vs ray tracer") {
 TEST_SUITE("hard cases 06") {
     TEST_CASE("hard case: view direction parallel to up still renders and agrees") {
         Scene s = generatedScene(2);
-        Camera c = makeCamera(Vec3(0, 5, 0), Vec3(0, 0, 0), Vec3(0, 1, 0), 60.0f, 1.0f);
+        Camera c = Camera::lookingAt(Vec3(0, 5, 0), Vec3(0, 0, 0), Vec3(0, 1, 0), 60.0f, 1.0f);
         Agreement a = agreementOf(s, c, 80, 80);
         CHECK(a.visibility.coveredEither > 1000);
         // Seen straight from above, the terrain's grid lines run through pixel centres:
@@ -471,7 +462,7 @@ TEST_SUITE("hard cases 06") {
         s.mesh.triangles = {{0, 1, 2}};
         s.mesh.computeVertexNormals();
         attachGrid(s);
-        Camera c = makeCamera(Vec3(0, 0, 0), Vec3(0, -0.3f, -1), Vec3(0, 1, 0), 80.0f, 1.0f);
+        Camera c = Camera::lookingAt(Vec3(0, 0, 0), Vec3(0, -0.3f, -1), Vec3(0, 1, 0), 80.0f, 1.0f);
         Agreement a = agreementOf(s, c, 64, 64);
         CHECK(a.stats.clipped == 1);
         CHECK(a.visibility.coveredRaster > 1000);
@@ -512,7 +503,7 @@ TEST_SUITE("hard cases 06") {
         RasterSettings rs;
         rs.width = rs.height = 32;
         FrameBuffers b;
-        Camera c = makeCamera(Vec3(0, 0, 3), Vec3(0, 0, 0), Vec3(0, 1, 0), 60.0f, 1.0f);
+        Camera c = Camera::lookingAt(Vec3(0, 0, 3), Vec3(0, 0, 0), Vec3(0, 1, 0), 60.0f, 1.0f);
         FrameStats stats = rasterizeFrame(raster, c, rs, b);
         CHECK(stats.pixelsCovered > 50);
         for (uint32_t id : b.triangle) CHECK((id == kNoPrimitive || id == 0));
@@ -527,7 +518,7 @@ TEST_SUITE("hard cases 06") {
     TEST_CASE("hard case: near and far are checked") {
         Scene s = generatedScene(1);
         RasterScene raster = RasterScene::fromScene(s);
-        Camera c = makeCamera(Vec3(0, 2, 4), Vec3(0, 0, 0), Vec3(0, 1, 0), 60.0f, 1.0f);
+        Camera c = Camera::lookingAt(Vec3(0, 2, 4), Vec3(0, 0, 0), Vec3(0, 1, 0), 60.0f, 1.0f);
         RasterSettings rs;
         rs.near = -1.0;
         CHECK_THROWS_AS(nearFarFor(raster, c, rs), InputError);
@@ -616,13 +607,14 @@ TEST_SUITE("frustum culling 06") {
     }
     TEST_CASE("the culled render is identical to the unculled one: bunny close-up") {
         Scene s = makeScene("bunny", {test::dataDir(), 4.0f / 3.0f});
-        checkCulledIdentical(s, makeCamera(Vec3(-0.35f, 0.55f, 0.9f), Vec3(-0.45f, 0.5f, 0.0f),
-                                           Vec3(0, 1, 0), 40.0f, 4.0f / 3.0f));
+        checkCulledIdentical(
+            s, Camera::lookingAt(Vec3(-0.35f, 0.55f, 0.9f), Vec3(-0.45f, 0.5f, 0.0f), Vec3(0, 1, 0),
+                                 40.0f, 4.0f / 3.0f));
     }
     TEST_CASE("the culled render is identical to the unculled one: inside a generated scene") {
         Scene s = generatedScene(5);
-        checkCulledIdentical(s, makeCamera(Vec3(0.0f, 0.5f, 0.0f), Vec3(1.0f, 0.3f, 0.2f),
-                                           Vec3(0, 1, 0), 60.0f, 4.0f / 3.0f));
+        checkCulledIdentical(s, Camera::lookingAt(Vec3(0.0f, 0.5f, 0.0f), Vec3(1.0f, 0.3f, 0.2f),
+                                                  Vec3(0, 1, 0), 60.0f, 4.0f / 3.0f));
     }
 }
 

@@ -533,42 +533,46 @@ TEST_SUITE("hard cases 06") {
 }
 
 TEST_SUITE("shadows 06") {
-    TEST_CASE("the hybrid's shadow rays match the ray tracer's shadows") {
+    // The bunny scene rasterized and ray traced (with shadow rays) at 160x120: the shadows
+    // shaded into the raster frame are compared with the ray tracer's.
+    struct BunnyFrames {
         Scene s = makeScene("bunny", {test::dataDir(), 4.0f / 3.0f});
-        attachGrid(s);
-        RasterScene raster = RasterScene::fromScene(s);
-        RasterSettings rs;
-        rs.width = 160;
-        rs.height = 120;
+        RasterScene raster;
         FrameBuffers b;
-        rasterizeFrame(raster, s.camera, rs, b);
-        TracedFrame traced = traceFrame(s, s.camera, rs.width, rs.height, true, 0);
+        TracedFrame traced;
+        BunnyFrames() {
+            attachGrid(s);
+            raster = RasterScene::fromScene(s);
+            RasterSettings rs;
+            rs.width = 160;
+            rs.height = 120;
+            rasterizeFrame(raster, s.camera, rs, b);
+            traced = traceFrame(s, s.camera, rs.width, rs.height, true, 0);
+        }
+        ShadowComparison compare(const ShadeSettings& ss,
+                                 const std::vector<ShadowMap>* maps = nullptr) const {
+            ShadedFrame f = shadeFrame(s, raster, s.camera, b, ss, maps);
+            return compareShadows(meshIds(raster, b), f.litByFirstLight, traced.ids,
+                                  traced.litByFirstLight);
+        }
+    };
+
+    TEST_CASE("the hybrid's shadow rays match the ray tracer's shadows") {
+        BunnyFrames frames;
         ShadeSettings ss;
         ss.shadows = ShadowMode::Rays;
-        ShadedFrame f = shadeFrame(s, raster, s.camera, b, ss);
-        ShadowComparison c = compareShadows(meshIds(raster, b), f.litByFirstLight, traced.ids,
-                                            traced.litByFirstLight);
+        ShadowComparison c = frames.compare(ss);
         CHECK(c.compared > 2500);
         CHECK(c.disagreement() < 0.002);
     }
     TEST_CASE("the shadow map: acne without bias and peter-panning with too much") {
-        Scene s = makeScene("bunny", {test::dataDir(), 4.0f / 3.0f});
-        attachGrid(s);
-        RasterScene raster = RasterScene::fromScene(s);
-        RasterSettings rs;
-        rs.width = 160;
-        rs.height = 120;
-        FrameBuffers b;
-        rasterizeFrame(raster, s.camera, rs, b);
-        TracedFrame traced = traceFrame(s, s.camera, rs.width, rs.height, true, 0);
-        std::vector<ShadowMap> maps{buildShadowMap(raster, s.lights[0], 1024)};
+        BunnyFrames frames;
+        std::vector<ShadowMap> maps{buildShadowMap(frames.raster, frames.s.lights[0], 1024)};
         auto compareAt = [&](double relativeBias) {
             ShadeSettings ss;
             ss.shadows = ShadowMode::Map;
-            ss.mapBias = relativeBias * double(raster.diagonal());
-            ShadedFrame f = shadeFrame(s, raster, s.camera, b, ss, &maps);
-            return compareShadows(meshIds(raster, b), f.litByFirstLight, traced.ids,
-                                  traced.litByFirstLight);
+            ss.mapBias = relativeBias * double(frames.raster.diagonal());
+            return frames.compare(ss, &maps);
         };
         ShadowComparison none = compareAt(1e-12), good = compareAt(2e-3), large = compareAt(5e-2);
         INFO("acne " << none.acne << " / " << good.acne << " / " << large.acne << ", leaks "

@@ -151,7 +151,6 @@ int main(int argc, char** argv) {
         WindowCallbacks cb;
         cb.keys = {{SDLK_t, "next triangle test (plane / Moller-Trumbore / watertight)"},
                    {SDLK_m, "mark pixels where the tests disagree (magenta)"}};
-        for (const KeyBinding& k : OrbitController::keys()) cb.keys.push_back(k);
         cb.onKey = [&](int key) {
             if (key == SDLK_t) {
                 test = TriangleTest((int(test) + 1) % 3);
@@ -163,13 +162,9 @@ int main(int argc, char** argv) {
                 dirty = true;
                 return true;
             }
-            if (orbit.onKey(key)) return dirty = true;
             return false;
         };
-        cb.onMouseDrag = [&](float dx, float dy) {
-            orbit.onDrag(dx, dy);
-            dirty = true;
-        };
+        orbit.addTo(cb, [&] { dirty = true; });
         cb.frame = [&](double) -> const Image& {
             if (dirty) {
                 if (grid) grid->setTest(test);

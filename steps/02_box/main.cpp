@@ -156,7 +156,6 @@ int main(int argc, char** argv) {
         WindowCallbacks cb;
         cb.keys = {{SDLK_m, "switch method: six planes / slabs"},
                    {SDLK_d, "mark pixels where the two methods disagree (magenta)"}};
-        for (const KeyBinding& k : OrbitController::keys()) cb.keys.push_back(k);
         cb.onKey = [&](int key) {
             if (key == SDLK_m) {
                 method = method == BoxMethod::Slabs ? BoxMethod::SixPlanes : BoxMethod::Slabs;
@@ -167,13 +166,9 @@ int main(int argc, char** argv) {
                 if (marks) set->setMethod(BoxMethod::SixPlanes);
                 return dirty = true;
             }
-            if (orbit.onKey(key)) return dirty = true;
             return false;
         };
-        cb.onMouseDrag = [&](float dx, float dy) {
-            orbit.onDrag(dx, dy);
-            dirty = true;
-        };
+        orbit.addTo(cb, [&] { dirty = true; });
         cb.frame = [&](double) -> const Image& {
             if (dirty) {
                 set->setMethod(method);

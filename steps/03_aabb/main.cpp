@@ -112,19 +112,14 @@ int main(int argc, char** argv) {
         double renderMs = 0.0, testsPerRay = 0.0, boxesPerRay = 0.0;
         WindowCallbacks cb;
         cb.keys = {{SDLK_b, "bounding-box pre-test on / off (off: quarter resolution)"}};
-        for (const KeyBinding& k : OrbitController::keys()) cb.keys.push_back(k);
         cb.onKey = [&](int key) {
             if (key == SDLK_b) {
                 pretest = !pretest;
                 return dirty = true;
             }
-            if (orbit.onKey(key)) return dirty = true;
             return false;
         };
-        cb.onMouseDrag = [&](float dx, float dy) {
-            orbit.onDrag(dx, dy);
-            dirty = true;
-        };
+        orbit.addTo(cb, [&] { dirty = true; });
         cb.frame = [&](double) -> const Image& {
             if (dirty) {
                 objects.setPretest(pretest);

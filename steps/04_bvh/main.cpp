@@ -297,7 +297,6 @@ int main(int argc, char** argv) {
                    {SDLK_l, "show deeper boxes in the map"},
                    {SDLK_k, "show shallower boxes in the map"},
                    {SDLK_f, "far plane: through the target / 3x further"}};
-        for (const KeyBinding& k : OrbitController::keys()) cb.keys.push_back(k);
         cb.onKey = [&](int key) {
             if (key == SDLK_b && geometry) {
                 buildOptions.builder = BvhBuilder((int(buildOptions.builder) + 1) % 3);
@@ -319,13 +318,9 @@ int main(int argc, char** argv) {
                 farScale = farScale == 1.0f ? 3.0f : 1.0f;
                 return dirty = true;
             }
-            if (orbit.onKey(key)) return dirty = true;
             return false;
         };
-        cb.onMouseDrag = [&](float dx, float dy) {
-            orbit.onDrag(dx, dy);
-            dirty = true;
-        };
+        orbit.addTo(cb, [&] { dirty = true; });
         cb.frame = [&](double) -> const Image& {
             if (!dirty) return image;
             Stopwatch watch;

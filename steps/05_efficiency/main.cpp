@@ -268,7 +268,6 @@ int main(int argc, char** argv) {
                    {SDLK_0, "preview: full render every frame"},
                    {SDLK_p, "photograph: deep recursion, anti-aliasing, saves a PNG"},
                    {SDLK_ESCAPE, "cancel the photograph (quits when none runs)"}};
-        for (const KeyBinding& k : OrbitController::keys()) cb.keys.push_back(k);
         cb.onKey = [&](int key) {
             if (photo && key == SDLK_ESCAPE) {
                 photo.reset();
@@ -306,17 +305,12 @@ int main(int argc, char** argv) {
                 photoMessage.clear();
                 return true;
             }
-            if (orbit.onKey(key)) {
-                photoShown = Image();
-                return moved = true;
-            }
             return false;
         };
-        cb.onMouseDrag = [&](float dx, float dy) {
-            orbit.onDrag(dx, dy);
-            photoShown = Image();
+        orbit.addTo(cb, [&] {
+            photoShown = Image();  // a moved camera leaves the photograph
             moved = true;
-        };
+        });
         cb.frame = [&](double) -> const Image& {
             if (photo) {
                 photo->advance(photoBudget);

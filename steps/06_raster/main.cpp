@@ -235,7 +235,6 @@ int main(int argc, char** argv) {
                    {SDLK_p, "perspective-correct / affine interpolation"},
                    {SDLK_c, "checker on the surfaces (shows the interpolation)"},
                    {SDLK_f, "frustum culling with step 04's hierarchy on / off"}};
-        for (const KeyBinding& k : OrbitController::keys()) cb.keys.push_back(k);
         cb.onKey = [&](int key) {
             switch (key) {
                 case SDLK_r:
@@ -257,14 +256,11 @@ int main(int argc, char** argv) {
                     ss.checker = !ss.checker;
                     break;
                 default:
-                    if (!orbit.onKey(key)) return false;
+                    return false;
             }
             return dirty = true;
         };
-        cb.onMouseDrag = [&](float dx, float dy) {
-            orbit.onDrag(dx, dy);
-            dirty = true;
-        };
+        orbit.addTo(cb, [&] { dirty = true; });
         cb.frame = [&](double) -> const Image& {
             if (!dirty) return image;
             const Camera& camera = orbit.camera();

@@ -695,25 +695,16 @@ TEST_SUITE("program 04") {
 
     TEST_CASE("headless render writes a PNG of the requested size and the culling map") {
         test::TempDir dir;
-        auto run = test::runProgram(
-            program, "--headless --scene sh1 --width 64 --height 40 --out a.png", dir);
-        INFO(run.err);
-        REQUIRE(run.exitCode == 0);
-        CHECK(test::pngSize(dir.file("a.png")) == std::pair{64, 40});
+        test::runHeadless(program, dir, 64, 40, "--scene sh1");
         CHECK(test::pngSize(dir.file("a-cull.png")) == std::pair{64, 40});
     }
     TEST_CASE("measurements: the JSON report has the step tables") {
         test::TempDir dir;
-        auto run = test::runProgram(program,
-                                    "--headless --scene sh1 --width 32 --height 24 --out a.png "
-                                    "--measure --measure-rays 400 --crack-rays 100 --report r.json",
-                                    dir);
-        INFO(run.err);
-        REQUIRE(run.exitCode == 0);
-        std::string json = test::readText(dir.file("r.json"));
-        for (const char* id :
-             {"bvh_build", "bvh_trace", "bvh_threads", "bvh_cracks", "bvh_culling", "bvh_tradeoff"})
-            CHECK(json.find(std::string("\"") + id + "\"") != std::string::npos);
+        test::runHeadless(
+            program, dir, 32, 24,
+            "--scene sh1 --measure --measure-rays 400 --crack-rays 100 --report r.json");
+        test::checkReportTables(dir.file("r.json"), {"bvh_build", "bvh_trace", "bvh_threads",
+                                                     "bvh_cracks", "bvh_culling", "bvh_tradeoff"});
     }
     TEST_CASE("trace command: hits equal brute force and the JSON line") {
         test::TempDir dir;
@@ -767,14 +758,8 @@ TEST_SUITE("program 04") {
     }
     TEST_CASE("window: scripted frames with key presses under the offscreen video driver") {
         test::TempDir dir;
-        auto run =
-            test::runProgram(program,
-                             "--scene sh1 --width 96 --height 48 --frames 5 --keys b,c,l,f,Left "
-                             "--screenshot shot.png",
-                             dir, test::kWindowEnvironment);
-        INFO(run.err);
-        REQUIRE(run.exitCode == 0);
-        CHECK(test::pngSize(dir.file("shot.png")).first > 0);
+        test::runWindowScript(program, dir, "--scene sh1 --width 96 --height 48", 5,
+                              "b,c,l,f,Left");
     }
     TEST_CASE("bad input: one clear line and a non-zero exit") {
         test::TempDir dir;
@@ -786,28 +771,16 @@ TEST_SUITE("program 04") {
         float good[8] = {0, 0, 0, 0, 1, 0, 0, 1};
         std::ofstream(dir.file("good.bin"), std::ios::binary)
             .write(reinterpret_cast<const char*>(good), sizeof(good));
-        struct Case {
-            std::string args, expect;
-            int code;
-        };
-        for (const Case& c : std::vector<Case>{
-                 {"trace --mesh " + mesh + " --rays short.bin --hits bad.bin", "multiple of 32", 1},
-                 {"trace --mesh " + mesh + " --rays nan.bin --hits bad.bin", "NaN", 1},
-                 {"trace --mesh missing.obj --rays good.bin --hits bad.bin", "no such file", 1},
-                 {"trace --mesh " + mesh + " --rays none.bin --hits bad.bin", "no such file", 1},
-                 {"trace --mesh " + mesh + " --rays good.bin --hits bad.bin --builder x", "builder",
-                  2},
-                 {"trace --mesh " + mesh + " --rays good.bin --hits bad.bin --threads 0", "threads",
-                  2},
-                 {"--headless --out bad.png --scene missing.obj", "no such file", 1},
-                 {"--headless --out bad.png --bins 1", "bins", 2}}) {
-            INFO(c.args);
-            auto run = test::runProgram(program, c.args, dir);
-            CHECK(run.exitCode == c.code);
-            CHECK(test::lineCount(run.err) == 1);
-            CHECK(run.err.find(c.expect) != std::string::npos);
-            CHECK_FALSE(std::filesystem::exists(dir.file("bad.bin")));
-            CHECK_FALSE(std::filesystem::exists(dir.file("bad.png")));
-        }
+        test::checkBadInput(
+            program, dir,
+            {{"trace --mesh " + mesh + " --rays short.bin --hits bad.bin", "multiple of 32", 1},
+             {"trace --mesh " + mesh + " --rays nan.bin --hits bad.bin", "NaN", 1},
+             {"trace --mesh missing.obj --rays good.bin --hits bad.bin", "no such file", 1},
+             {"trace --mesh " + mesh + " --rays none.bin --hits bad.bin", "no such file", 1},
+             {"trace --mesh " + mesh + " --rays good.bin --hits bad.bin --builder x", "builder", 2},
+             {"trace --mesh " + mesh + " --rays good.bin --hits bad.bin --threads 0", "threads", 2},
+             {"--headless --out bad.png --scene missing.obj", "no such file", 1},
+             {"--headless --out bad.png --bins 1", "bins", 2}},
+            "", {"bad.bin", "bad.png"});
     }
 }

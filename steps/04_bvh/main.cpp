@@ -129,12 +129,6 @@ int runCheck(const CheckOptions& o) {
     return total == 0 ? 0 : 1;
 }
 
-std::string withSuffix(const std::string& png, const std::string& suffix) {
-    std::string stem =
-        png.size() > 4 && png.ends_with(".png") ? png.substr(0, png.size() - 4) : png;
-    return stem + suffix + ".png";
-}
-
 const char* testName(CullTest test) {
     return test == CullTest::Planes ? "planes (p-vertex)" : "planes + frustum corners";
 }
@@ -219,28 +213,16 @@ int main(int argc, char** argv) {
             scene.geometries.push_back(geometry);
         }
         Vec3 sceneUp = scene.camera.up;
-        RenderSettings settings;
-        settings.width = opts.width;
-        settings.height = opts.height;
-        settings.threads = opts.threads;
-        settings.seed = opts.seed;
+        RenderSettings settings = opts.renderSettings();
 
         if (opts.headless) {
             Report report;
             report.program = "04_bvh";
-            std::string out = opts.out.empty() ? "04_bvh.png" : opts.out;
-            settings.progressLabel = "04_bvh: rendering";
-            Stopwatch watch;
-            RayCounts counts;
-            Image image = renderImage(scene, scene.camera, settings, &counts);
-            double renderSeconds = watch.seconds();
-            image.writePng(out);
-            report.images.push_back({out, "scene '" + scene.name + "' through the " +
-                                              bvhBuilderName(buildOptions.builder) + " hierarchy"});
-            report.facts["render_ms"] = renderSeconds * 1e3;
-            report.facts["rays"] = counts.total();
-            std::cerr << "04_bvh: wrote " << out << " (" << image.width() << "x" << image.height()
-                      << ", " << formatSeconds(renderSeconds) << ")\n";
+            std::string out = headlessPath(opts, report.program);
+            renderHeadlessImage(scene, scene.camera, settings, out,
+                                "scene '" + scene.name + "' through the " +
+                                    bvhBuilderName(buildOptions.builder) + " hierarchy",
+                                report);
             if (geometry) {
                 const BvhBuildStats& s = geometry->stats();
                 report.facts["build_ms"] = s.buildMs;
@@ -252,7 +234,7 @@ int main(int argc, char** argv) {
                 Image map(opts.width, opts.height);
                 drawCullingMap(map, 0, opts.width, geometry->bvh(), f, CullTest::Planes, 6,
                                sceneUp);
-                std::string mapPath = withSuffix(out, "-cull");
+                std::string mapPath = pngWithSuffix(out, "-cull");
                 map.writePng(mapPath);
                 report.images.push_back(
                     {mapPath,
@@ -292,8 +274,7 @@ int main(int argc, char** argv) {
                                         {"series", "builder"},
                                         {"title", "Builders: build time against trace speed"}});
             }
-            report.write(opts.json ? std::cerr : std::cout, opts.json ? "-" : opts.reportPath);
-            if (opts.json && !opts.reportPath.empty()) report.write(std::cerr, opts.reportPath);
+            writeReport(report, opts);
             return 0;
         }
 
@@ -316,7 +297,6 @@ int main(int argc, char** argv) {
                    {SDLK_l, "show deeper boxes in the map"},
                    {SDLK_k, "show shallower boxes in the map"},
                    {SDLK_f, "far plane: through the target / 3x further"}};
-        for (const KeyBinding& k : OrbitController::keys()) cb.keys.push_back(k);
         cb.onKey = [&](int key) {
             if (key == SDLK_b && geometry) {
                 buildOptions.builder = BvhBuilder((int(buildOptions.builder) + 1) % 3);
@@ -338,13 +318,9 @@ int main(int argc, char** argv) {
                 farScale = farScale == 1.0f ? 3.0f : 1.0f;
                 return dirty = true;
             }
-            if (orbit.onKey(key)) return dirty = true;
             return false;
         };
-        cb.onMouseDrag = [&](float dx, float dy) {
-            orbit.onDrag(dx, dy);
-            dirty = true;
-        };
+        orbit.addTo(cb, [&] { dirty = true; });
         cb.frame = [&](double) -> const Image& {
             if (!dirty) return image;
             Stopwatch watch;

@@ -255,6 +255,9 @@ int main(int argc, char** argv) {
                 case SDLK_c:
                     ss.checker = !ss.checker;
                     break;
+                case SDLK_f:
+                    culling = !culling;
+                    break;
                 default:
                     return false;
             }

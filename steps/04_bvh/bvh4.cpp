@@ -1,0 +1,118 @@
+#include "04_bvh/bvh4.hpp"
+
+#include <algorithm>
+
+namespace boxes {
+
+namespace {
+
+struct Collapser {
+    const Bvh& binary;
+    std::vector<Bvh4Node>& nodes;
+
+    // Emits the 4-wide node for the binary inner node `inner` (and, depth first, its
+    // subtree); returns its index.
+    uint32_t emit(uint32_t inner) {
+        const BvhNode* b = binary.nodes.data();
+        uint32_t kids[4] = {b[inner].leftFirst, b[inner].leftFirst + 1, 0, 0};
+        int n = 2;
+        while (n < 4) {
+            // Open the inner child with the largest surface area (-1: flat and point boxes
+            // have area 0 and are still opened).
+            // (In double: in float the area of a box 1e20 across is infinite.)
+            int open = -1;
+            double openArea = -1.0;
+            for (int i = 0; i < n; ++i) {
+                if (b[kids[i]].isLeaf()) continue;
+                Bounds3d box(Vec3d(b[kids[i]].boundsMin), Vec3d(b[kids[i]].boundsMax));
+                double area = box.surfaceArea();
+                if (area > openArea) {
+                    open = i;
+                    openArea = area;
+                }
+            }
+            if (open < 0) break;
+            uint32_t opened = kids[open];
+            kids[open] = b[opened].leftFirst;
+            kids[n++] = b[opened].leftFirst + 1;
+        }
+        uint32_t index = uint32_t(nodes.size());
+        nodes.push_back(emptyNode());
+        for (int i = 0; i < n; ++i) {
+            const BvhNode& c = b[kids[i]];
+            uint32_t child = c.isLeaf() ? c.leftFirst : emit(kids[i]);
+            Bvh4Node& node = nodes[index];  // after emit: the vector may have moved
+            setChild(node, i, c.bounds(), child, c.count);
+        }
+        return index;
+    }
+
+    static Bvh4Node emptyNode() {
+        Bvh4Node node{};
+        for (int i = 0; i < 4; ++i) setChild(node, i, Bounds3f(), 0, 0);
+        return node;
+    }
+    static void setChild(Bvh4Node& node, int i, const Bounds3f& bounds, uint32_t child,
+                         uint32_t count) {
+        for (int axis = 0; axis < 3; ++axis) {
+            node.boundsMin[axis][i] = bounds.min[axis];
+            node.boundsMax[axis][i] = bounds.max[axis];
+        }
+        node.child[i] = child;
+        node.count[i] = count;
+    }
+};
+
+}  // namespace
+
+Bvh4 collapseToBvh4(Bvh binary) {
+    Bvh4 wide;
+    if (binary.empty()) return wide;
+    wide.rootBounds = binary.bounds();
+    Collapser collapser{binary, wide.nodes};
+    const BvhNode& root = binary.nodes[0];
+    if (root.isLeaf()) {
+        wide.nodes.push_back(Collapser::emptyNode());
+        Collapser::setChild(wide.nodes[0], 0, root.bounds(), root.leftFirst, root.count);
+    } else {
+        wide.nodes.reserve(binary.nodes.size() / 2 + 1);
+        collapser.emit(0);
+        wide.nodes.shrink_to_fit();
+    }
+    wide.primitiveIndices = std::move(binary.primitiveIndices);
+    wide.leafTriangles = std::move(binary.leafTriangles);
+    return wide;
+}
+
+Bvh4Stats bvh4Stats(const Bvh4& bvh) {
+    Bvh4Stats s;
+    s.nodes = bvh.nodes.size();
+    if (bvh.empty()) return s;
+    std::vector<std::pair<uint32_t, int>> stack = {{0, 0}};
+    while (!stack.empty()) {
+        auto [index, depth] = stack.back();
+        stack.pop_back();
+        const Bvh4Node& node = bvh.nodes[index];
+        for (int i = 0; i < 4; ++i) {
+            if (node.isEmpty(i)) {
+                ++s.emptySlots;
+            } else if (node.isLeaf(i)) {
+                ++s.leaves;
+                s.depth = std::max(s.depth, depth + 1);
+            } else {
+                stack.push_back({node.child[i], depth + 1});
+            }
+        }
+    }
+    return s;
+}
+
+void traceBatch(const Bvh4& bvh, const std::vector<Ray>& rays, std::vector<TraceHit>& hits,
+                int threads) {
+    hits.resize(rays.size());
+    forEachRayChunk(rays.size(), threads, [&](size_t begin, size_t end) {
+        for (size_t i = begin; i < end; ++i) hits[i] = traceNearest(bvh, rays[i]);
+    });
+}
+
+}  // namespace boxes

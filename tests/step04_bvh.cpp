@@ -701,11 +701,12 @@ Bvh4 wideTree(const Mesh& m, BvhBuilder builder = BvhBuilder::SweepSah) {
     return collapseToBvh4(buildBvh(m, optionsFor(builder)));
 }
 
-// Every slot in exactly one leaf child, every inner child's box the union of its node's
-// children, empty slots only after the filled ones.
-void checkStructure4(const Bvh4& wide, size_t slots) {
+// Every primitive in exactly one leaf child, leaves starting a packet of four slots, every
+// inner child's box the union of its node's children, empty slots after the filled ones.
+void checkStructure4(const Bvh4& wide, size_t primitives) {
     REQUIRE_FALSE(wide.empty());
-    std::vector<int> seen(slots, 0);
+    REQUIRE(wide.primitiveIndices.size() % 4 == 0);
+    std::vector<int> seen(primitives, 0);
     std::vector<std::pair<uint32_t, Bounds3f>> stack = {{0, wide.bounds()}};
     size_t reached = 0;
     while (!stack.empty()) {
@@ -725,8 +726,15 @@ void checkStructure4(const Bvh4& wide, size_t slots) {
             unionOfChildren.extend(node.bounds(i).min);
             unionOfChildren.extend(node.bounds(i).max);
             if (node.isLeaf(i)) {
-                REQUIRE(size_t(node.child[i]) + node.count[i] <= slots);
-                for (uint32_t s = node.child[i]; s < node.child[i] + node.count[i]; ++s) ++seen[s];
+                REQUIRE(size_t(node.child[i]) + node.count[i] <= wide.primitiveIndices.size());
+                CHECK(node.child[i] % 4 == 0);
+                for (uint32_t s = node.child[i]; s < node.child[i] + node.count[i]; ++s) {
+                    uint32_t p = wide.primitiveIndices[s];
+                    REQUIRE(p < primitives);
+                    ++seen[p];
+                    if (!wide.packets.empty())  // the packet holds the slot's triangle
+                        CHECK(wide.packets[s / 4].vertex[2][1][s % 4] == wide.leafTriangles[s].c.y);
+                }
             } else {
                 REQUIRE(node.child[i] > index);
                 stack.push_back({node.child[i], node.bounds(i)});
@@ -873,6 +881,58 @@ TEST_SUITE("bvh 4-wide") {
                 CHECK(t == 1.0);
                 CHECK(traceNearest(wide, ray) == TraceHit{1.0f, 0u});
             }
+    }
+    TEST_CASE("4-wide: the four-triangle leaf test equals the scalar test bit for bit") {
+        // One leaf of 7 triangles (two packets, the last lane a repeat): large overlapping
+        // triangles, a fan around the point (0.5, 0.5) the rays aim at (edge functions
+        // exactly 0 go to the scalar test), and a zero-area one.
+        std::mt19937_64 rng(42);
+        std::uniform_real_distribution<float> u(0.0f, 1.0f);
+        size_t hits = 0;
+        for (int round = 0; round < 300; ++round) {
+            Mesh m;
+            Vec3 centre(0.5f, 0.5f, u(rng));
+            for (int i = 0; i < 7; ++i) {
+                uint32_t base = uint32_t(m.positions.size());
+                if (i < 3) {  // the fan: all share the centre
+                    m.positions.insert(m.positions.end(), {centre, Vec3(u(rng), u(rng), u(rng)),
+                                                           Vec3(u(rng), u(rng), u(rng))});
+                } else if (i == 3) {  // zero area: three points on a line
+                    Vec3 a(u(rng), u(rng), u(rng));
+                    m.positions.insert(m.positions.end(), {a, a + Vec3(0.1f), a + Vec3(0.2f)});
+                } else {
+                    for (int k = 0; k < 3; ++k) m.positions.push_back(Vec3(u(rng), u(rng), u(rng)));
+                }
+                m.triangles.push_back({base, base + 1, base + 2});
+            }
+            BvhBuildOptions one = optionsFor(BvhBuilder::SweepSah);
+            one.maxLeafSize = 16;
+            one.intersectionCost = 0.01f;  // a leaf is cheaper than any split
+            Bvh4 wide = collapseToBvh4(buildBvh(m, one));
+            REQUIRE(wide.nodes.size() == 1);
+            REQUIRE(wide.nodes[0].count[0] == 7);
+            Vec3 origin(u(rng) * 4.0f - 2.0f, u(rng) * 4.0f - 2.0f, 3.0f);
+            Ray ray(origin, (round % 2 ? centre : Vec3(u(rng), u(rng), 0.5f)) - origin);
+            WatertightRay w(ray);
+            WatertightRay4 w4(w);
+            withWatertightAxes(w, [&](auto axes) {
+                float tPacket = ray.tmax, tScalar = ray.tmax;
+                uint32_t slot = intersectLeafPackets(axes, w, w4, wide, 0, 7, tPacket);
+                uint32_t scalarSlot = kTraversalMiss;
+                for (uint32_t s = 0; s < 7; ++s)
+                    if (intersectLeafTriangle(axes, w, wide.leafTriangles[s], tScalar))
+                        scalarSlot = s;
+                CHECK(tPacket == tScalar);
+                CHECK((slot == kTraversalMiss) == (scalarSlot == kTraversalMiss));
+                if (slot != kTraversalMiss) {
+                    float tSlot = ray.tmax;
+                    CHECK(intersectLeafTriangle(axes, w, wide.leafTriangles[slot], tSlot));
+                    CHECK(tSlot == tPacket);  // the slot is one at that distance
+                    ++hits;
+                }
+            });
+        }
+        CHECK(hits > 150);
     }
     TEST_CASE("4-wide: nearest hit equals brute force on a triangle soup") {
         Mesh m = triangleSoup(2000, 32);

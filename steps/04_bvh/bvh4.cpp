@@ -8,7 +8,28 @@ namespace {
 
 struct Collapser {
     const Bvh& binary;
-    std::vector<Bvh4Node>& nodes;
+    Bvh4& wide;
+
+    // Copies a binary leaf's slots to the next whole packets; returns its first slot.
+    uint32_t emitLeaf(const BvhNode& leaf) {
+        uint32_t first = uint32_t(wide.primitiveIndices.size());
+        uint32_t padded = (leaf.count + 3) / 4 * 4;
+        bool triangles = !binary.leafTriangles.empty();
+        for (uint32_t i = 0; i < padded; ++i) {
+            uint32_t slot = leaf.leftFirst + std::min(i, leaf.count - 1);
+            wide.primitiveIndices.push_back(binary.primitiveIndices[slot]);
+            if (!triangles) continue;
+            const LeafTriangle& tri = binary.leafTriangles[slot];
+            if (i % 4 == 0) wide.packets.emplace_back();
+            TrianglePacket4& packet = wide.packets.back();
+            const Vec3* vertices[3] = {&tri.a, &tri.b, &tri.c};
+            for (int v = 0; v < 3; ++v)
+                for (int axis = 0; axis < 3; ++axis)
+                    packet.vertex[v][axis][i % 4] = (*vertices[v])[axis];
+            wide.leafTriangles.push_back(tri);
+        }
+        return first;
+    }
 
     // Emits the 4-wide node for the binary inner node `inner` (and, depth first, its
     // subtree); returns its index.
@@ -36,12 +57,12 @@ struct Collapser {
             kids[open] = b[opened].leftFirst;
             kids[n++] = b[opened].leftFirst + 1;
         }
-        uint32_t index = uint32_t(nodes.size());
-        nodes.push_back(emptyNode());
+        uint32_t index = uint32_t(wide.nodes.size());
+        wide.nodes.push_back(emptyNode());
         for (int i = 0; i < n; ++i) {
             const BvhNode& c = b[kids[i]];
-            uint32_t child = c.isLeaf() ? c.leftFirst : emit(kids[i]);
-            Bvh4Node& node = nodes[index];  // after emit: the vector may have moved
+            uint32_t child = c.isLeaf() ? emitLeaf(c) : emit(kids[i]);
+            Bvh4Node& node = wide.nodes[index];  // after emit: the vector may have moved
             setChild(node, i, c.bounds(), child, c.count);
         }
         return index;
@@ -65,22 +86,28 @@ struct Collapser {
 
 }  // namespace
 
-Bvh4 collapseToBvh4(Bvh binary) {
+Bvh4 collapseToBvh4(const Bvh& binary) {
     Bvh4 wide;
     if (binary.empty()) return wide;
     wide.rootBounds = binary.bounds();
-    Collapser collapser{binary, wide.nodes};
+    Collapser collapser{binary, wide};
+    size_t slots = binary.primitiveIndices.size();
+    wide.primitiveIndices.reserve(slots + slots / 2);
+    wide.leafTriangles.reserve(binary.leafTriangles.empty() ? 0 : slots + slots / 2);
+    wide.packets.reserve(binary.leafTriangles.empty() ? 0 : slots / 2);
     const BvhNode& root = binary.nodes[0];
     if (root.isLeaf()) {
         wide.nodes.push_back(Collapser::emptyNode());
-        Collapser::setChild(wide.nodes[0], 0, root.bounds(), root.leftFirst, root.count);
+        uint32_t first = collapser.emitLeaf(root);
+        Collapser::setChild(wide.nodes[0], 0, root.bounds(), first, root.count);
     } else {
         wide.nodes.reserve(binary.nodes.size() / 2 + 1);
         collapser.emit(0);
-        wide.nodes.shrink_to_fit();
     }
-    wide.primitiveIndices = std::move(binary.primitiveIndices);
-    wide.leafTriangles = std::move(binary.leafTriangles);
+    wide.nodes.shrink_to_fit();
+    wide.primitiveIndices.shrink_to_fit();
+    wide.leafTriangles.shrink_to_fit();
+    wide.packets.shrink_to_fit();
     return wide;
 }
 

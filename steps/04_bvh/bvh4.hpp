@@ -49,18 +49,27 @@ struct alignas(64) Bvh4Node {
 };
 static_assert(sizeof(Bvh4Node) == 128, "two 64-byte cache lines");
 
+// Four triangles "structure of arrays" (vertex, axis, lane) for the 4-triangle leaf test.
+struct alignas(16) TrianglePacket4 {
+    float vertex[3][3][4];
+};
+
+// Slots are regrouped by four: every leaf starts a packet (slot first = 4 * packet), and
+// the lanes after a leaf's last triangle repeat that triangle (same primitive index), so
+// a leaf's slots [first, first + count) are packet lanes and a packet never mixes leaves.
 struct Bvh4 {
     std::vector<Bvh4Node> nodes;  // nodes[0] is the root (when not empty); alignas: new aligns
-    std::vector<uint32_t> primitiveIndices;   // the binary tree's slots
-    std::vector<LeafTriangle> leafTriangles;  // meshes only
+    std::vector<uint32_t> primitiveIndices;   // slot -> primitive
+    std::vector<LeafTriangle> leafTriangles;  // meshes only: slot -> vertices
+    std::vector<TrianglePacket4> packets;     // meshes only: the same by four
     Bounds3f rootBounds;
 
     bool empty() const { return nodes.empty(); }
     Bounds3f bounds() const { return rootBounds; }
 };
 
-// Collapses a binary hierarchy (the arrays of slots and triangles move over).
-Bvh4 collapseToBvh4(Bvh binary);
+// Collapses a binary hierarchy (leaves are kept; their slots regrouped into packets).
+Bvh4 collapseToBvh4(const Bvh& binary);
 
 struct Bvh4Stats {
     size_t nodes = 0, leaves = 0, emptySlots = 0;
@@ -145,11 +154,12 @@ inline int intersectChildBounds(const Bvh4Node& node, const Bvh4Ray& ray, float 
 // Inner children push up to three entries per level, and the builders cap the depth at 64.
 constexpr int kBvh4StackSize = 256;
 
-// Nearest hit, nearest child first, early out; the interface of traverseNearest
-// (intersect(slot, tClosest) lowers tClosest on a hit). Returns the slot or kTraversalMiss.
-template <typename PrimitiveIntersector>
-uint32_t traverseNearest4(const Bvh4& bvh, const TraversalRay& traversal, float& tClosest,
-                          PrimitiveIntersector&& intersect) {
+// Nearest hit, nearest child first, early out. intersectLeaf(first, count, tClosest) tests
+// a leaf's slots [first, first + count), lowers tClosest on a hit and returns the slot of
+// its nearest hit (or kTraversalMiss). Returns the slot of the nearest hit or kTraversalMiss.
+template <typename LeafIntersector>
+uint32_t traverseNearest4Leaves(const Bvh4& bvh, const TraversalRay& traversal, float& tClosest,
+                                LeafIntersector&& intersectLeaf) {
     if (bvh.empty()) return kTraversalMiss;
     const Bvh4Ray ray(traversal);
     const Bvh4Node* nodes = bvh.nodes.data();
@@ -191,8 +201,8 @@ uint32_t traverseNearest4(const Bvh4& bvh, const TraversalRay& traversal, float&
                 continue;
             }
         } else {
-            for (uint32_t slot = child; slot < child + count; ++slot)
-                if (intersect(slot, tClosest)) nearestSlot = slot;
+            uint32_t slot = intersectLeaf(child, count, tClosest);
+            if (slot != kTraversalMiss) nearestSlot = slot;
         }
         // Pop until an entry the ray enters before the nearest hit so far.
         for (;;) {
@@ -207,10 +217,24 @@ uint32_t traverseNearest4(const Bvh4& bvh, const TraversalRay& traversal, float&
     }
 }
 
-// Any hit in [ray.tmin, ray.tmax] (shadow rays): no order, stop at the first hit.
+// The same with the interface of traverseNearest: intersect(slot, tClosest) per slot.
 template <typename PrimitiveIntersector>
-bool traverseAny4(const Bvh4& bvh, const TraversalRay& traversal,
-                  PrimitiveIntersector&& intersect) {
+uint32_t traverseNearest4(const Bvh4& bvh, const TraversalRay& traversal, float& tClosest,
+                          PrimitiveIntersector&& intersect) {
+    return traverseNearest4Leaves(bvh, traversal, tClosest,
+                                  [&](uint32_t first, uint32_t count, float& tmax) {
+                                      uint32_t nearest = kTraversalMiss;
+                                      for (uint32_t slot = first; slot < first + count; ++slot)
+                                          if (intersect(slot, tmax)) nearest = slot;
+                                      return nearest;
+                                  });
+}
+
+// Any hit in [ray.tmin, ray.tmax] (shadow rays): no order, stop at the first hit.
+// intersectLeaf(first, count, tmax) is true when a slot of the leaf is hit.
+template <typename LeafIntersector>
+bool traverseAny4Leaves(const Bvh4& bvh, const TraversalRay& traversal,
+                        LeafIntersector&& intersectLeaf) {
     if (bvh.empty()) return false;
     const Bvh4Ray ray(traversal);
     const Bvh4Node* nodes = bvh.nodes.data();
@@ -222,8 +246,7 @@ bool traverseAny4(const Bvh4& bvh, const TraversalRay& traversal,
     while (stackSize > 0) {
         Entry e = stack[--stackSize];
         if (e.count != 0) {
-            for (uint32_t slot = e.child; slot < e.child + e.count; ++slot)
-                if (intersect(slot, traversal.tmax)) return true;
+            if (intersectLeaf(e.child, e.count, traversal.tmax)) return true;
             continue;
         }
         const Bvh4Node& node = nodes[e.child];
@@ -238,20 +261,134 @@ bool traverseAny4(const Bvh4& bvh, const TraversalRay& traversal,
     return false;
 }
 
+template <typename PrimitiveIntersector>
+bool traverseAny4(const Bvh4& bvh, const TraversalRay& traversal,
+                  PrimitiveIntersector&& intersect) {
+    return traverseAny4Leaves(bvh, traversal, [&](uint32_t first, uint32_t count, float tmax) {
+        for (uint32_t slot = first; slot < first + count; ++slot)
+            if (intersect(slot, tmax)) return true;
+        return false;
+    });
+}
+
 // The margin of the scalar traversal, from the same root bounds.
 inline float traversalMargin(const Ray& ray, const Bvh4& bvh) {
     return bvh.empty() ? 0.0f : TraversalRay::marginFor(ray, bvh.bounds());
 }
 
+// The watertight test (intersectLeafTriangle) on the four triangles of a packet at once:
+// the same operations in the same order per lane, so every lane's u, v, w, det and t are
+// bit for bit the scalar test's. Lanes the scalar test would decide in double (an edge
+// function exactly 0, a non-finite det, a scaled t below the normal range) are handed to
+// it, one by one. Tests a leaf's slots [first, first + count) (first a multiple of 4) in
+// [ray.tmin, tClosest]; lowers tClosest to the nearest hit and returns its slot, or
+// kTraversalMiss. The sign test reads sign bits: for lanes whose u, v, w are all non-zero,
+// "some negative and some positive" is "the sign bits differ".
+struct WatertightRay4 {
+#if defined(__SSE2__)
+    __m128 origin[3], sx, sy, sz, tmin;
+    explicit WatertightRay4(const WatertightRay& r)
+        : origin{_mm_set1_ps(r.origin.x), _mm_set1_ps(r.origin.y), _mm_set1_ps(r.origin.z)},
+          sx(_mm_set1_ps(r.sx)),
+          sy(_mm_set1_ps(r.sy)),
+          sz(_mm_set1_ps(r.sz)),
+          tmin(_mm_set1_ps(r.tmin)) {}
+#else
+    explicit WatertightRay4(const WatertightRay&) {}
+#endif
+};
+
+template <typename Axes>
+inline uint32_t intersectLeafPackets(Axes axes, const WatertightRay& r, const WatertightRay4& r4,
+                                     const Bvh4& bvh, uint32_t first, uint32_t count,
+                                     float& tClosest) {
+    uint32_t nearest = kTraversalMiss;
+#if defined(__SSE2__)
+    constexpr int kx = Axes::kx, ky = Axes::ky, kz = Axes::kz;
+    const __m128 zero = _mm_setzero_ps(), one = _mm_set1_ps(1.0f);
+    const __m128i absMask = _mm_set1_epi32(0x7FFFFFFF);
+    for (uint32_t base = first; base < first + count; base += 4) {
+        const TrianglePacket4& p = bvh.packets[base / 4];
+        auto rel = [&](int v, int axis) {
+            return _mm_sub_ps(_mm_load_ps(p.vertex[v][axis]), r4.origin[axis]);
+        };
+        const __m128 aKz = rel(0, kz), bKz = rel(1, kz), cKz = rel(2, kz);
+        const __m128 ax = _mm_sub_ps(rel(0, kx), _mm_mul_ps(r4.sx, aKz));
+        const __m128 ay = _mm_sub_ps(rel(0, ky), _mm_mul_ps(r4.sy, aKz));
+        const __m128 bx = _mm_sub_ps(rel(1, kx), _mm_mul_ps(r4.sx, bKz));
+        const __m128 by = _mm_sub_ps(rel(1, ky), _mm_mul_ps(r4.sy, bKz));
+        const __m128 cx = _mm_sub_ps(rel(2, kx), _mm_mul_ps(r4.sx, cKz));
+        const __m128 cy = _mm_sub_ps(rel(2, ky), _mm_mul_ps(r4.sy, cKz));
+        __m128 u = _mm_sub_ps(_mm_mul_ps(cx, by), _mm_mul_ps(cy, bx));
+        __m128 v = _mm_sub_ps(_mm_mul_ps(ax, cy), _mm_mul_ps(ay, cx));
+        __m128 w = _mm_sub_ps(_mm_mul_ps(bx, ay), _mm_mul_ps(by, ax));
+        const __m128 det = _mm_add_ps(_mm_add_ps(u, v), w);
+        // Lanes for the scalar test: an edge function exactly 0 (cmpeq is a quiet compare),
+        // or det not finite (exponent bits all ones; integer compares raise nothing).
+        const __m128 anyZero = _mm_or_ps(_mm_or_ps(_mm_cmpeq_ps(u, zero), _mm_cmpeq_ps(v, zero)),
+                                         _mm_cmpeq_ps(w, zero));
+        const __m128 notFinite = _mm_castsi128_ps(_mm_cmpgt_epi32(
+            _mm_and_si128(_mm_castps_si128(det), absMask), _mm_set1_epi32(0x7F7FFFFF)));
+        __m128 scalar = _mm_or_ps(anyZero, notFinite);
+        const __m128 mixedSigns = _mm_castsi128_ps(
+            _mm_srai_epi32(_mm_castps_si128(_mm_or_ps(_mm_xor_ps(u, v), _mm_xor_ps(u, w))), 31));
+        // Lanes that go on to t: all signs equal, decided here (det != 0 follows).
+        const __m128 onward =
+            _mm_andnot_ps(_mm_or_ps(scalar, mixedSigns), _mm_cmpneq_ps(det, zero));
+        // Zero the others' edge functions and give them det 1: their t is then 0 / 1, no
+        // spurious overflow or 0 / 0 where the scalar test would not have computed t.
+        u = _mm_and_ps(u, onward);
+        v = _mm_and_ps(v, onward);
+        w = _mm_and_ps(w, onward);
+        const __m128 divisor = _mm_or_ps(_mm_and_ps(det, onward), _mm_andnot_ps(onward, one));
+        const __m128 tScaled = _mm_add_ps(_mm_add_ps(_mm_mul_ps(u, _mm_mul_ps(r4.sz, aKz)),
+                                                     _mm_mul_ps(v, _mm_mul_ps(r4.sz, bKz))),
+                                          _mm_mul_ps(w, _mm_mul_ps(r4.sz, cKz)));
+        const __m128 tiny = _mm_castsi128_ps(_mm_cmplt_epi32(
+            _mm_and_si128(_mm_castps_si128(tScaled), absMask), _mm_set1_epi32(0x00800000)));
+        scalar = _mm_or_ps(scalar, _mm_and_ps(tiny, onward));
+        const __m128 t = _mm_div_ps(tScaled, divisor);
+        const __m128 tmax = _mm_set1_ps(tClosest);
+        __m128 hit = _mm_andnot_ps(tiny, onward);
+        hit = _mm_and_ps(hit, _mm_and_ps(_mm_cmpge_ps(t, r4.tmin), _mm_cmple_ps(t, tmax)));
+        const uint32_t lanes = std::min(4u, first + count - base);
+        const int live = (1 << lanes) - 1;  // the lanes after a leaf's end repeat its last
+        int hitMask = _mm_movemask_ps(hit) & live;
+        if (hitMask != 0) {
+            __m128 tHit =
+                _mm_or_ps(_mm_and_ps(hit, t), _mm_andnot_ps(hit, _mm_set1_ps(kInfinity<float>)));
+            __m128 m = _mm_min_ps(tHit, _mm_shuffle_ps(tHit, tHit, _MM_SHUFFLE(2, 3, 0, 1)));
+            m = _mm_min_ps(m, _mm_shuffle_ps(m, m, _MM_SHUFFLE(1, 0, 3, 2)));
+            int lane = std::countr_zero(unsigned(_mm_movemask_ps(_mm_cmpeq_ps(tHit, m)) & hitMask));
+            tClosest = _mm_cvtss_f32(m);
+            nearest = base + uint32_t(lane);
+        }
+        int scalarMask = _mm_movemask_ps(scalar) & live;
+        while (scalarMask != 0) [[unlikely]] {
+                uint32_t slot = base + uint32_t(std::countr_zero(unsigned(scalarMask)));
+                scalarMask &= scalarMask - 1;
+                if (intersectLeafTriangle(axes, r, bvh.leafTriangles[slot], tClosest))
+                    nearest = slot;
+            }
+    }
+#else
+    (void)r4;
+    for (uint32_t slot = first; slot < first + count; ++slot)
+        if (intersectLeafTriangle(axes, r, bvh.leafTriangles[slot], tClosest)) nearest = slot;
+#endif
+    return nearest;
+}
+
 inline TraceHit traceNearest(const Bvh4& bvh, const Ray& ray) {
     TraversalRay traversal(ray, traversalMargin(ray, bvh));
     WatertightRay watertight(ray);
+    WatertightRay4 watertight4(watertight);
     float tClosest = ray.tmax;
-    const LeafTriangle* tris = bvh.leafTriangles.data();
     uint32_t slot = withWatertightAxes(watertight, [&](auto axes) {
-        return traverseNearest4(bvh, traversal, tClosest, [&](uint32_t s, float& tmax) {
-            return intersectLeafTriangle(axes, watertight, tris[s], tmax);
-        });
+        return traverseNearest4Leaves(
+            bvh, traversal, tClosest, [&](uint32_t first, uint32_t count, float& tmax) {
+                return intersectLeafPackets(axes, watertight, watertight4, bvh, first, count, tmax);
+            });
     });
     if (slot == kTraversalMiss) return {};
     return {tClosest, bvh.primitiveIndices[slot]};
@@ -260,10 +397,11 @@ inline TraceHit traceNearest(const Bvh4& bvh, const Ray& ray) {
 inline bool traceOccluded(const Bvh4& bvh, const Ray& ray) {
     TraversalRay traversal(ray, traversalMargin(ray, bvh));
     WatertightRay watertight(ray);
-    const LeafTriangle* tris = bvh.leafTriangles.data();
+    WatertightRay4 watertight4(watertight);
     return withWatertightAxes(watertight, [&](auto axes) {
-        return traverseAny4(bvh, traversal, [&](uint32_t s, float tmax) {
-            return intersectLeafTriangle(axes, watertight, tris[s], tmax);
+        return traverseAny4Leaves(bvh, traversal, [&](uint32_t first, uint32_t count, float tmax) {
+            return intersectLeafPackets(axes, watertight, watertight4, bvh, first, count, tmax) !=
+                   kTraversalMiss;
         });
     });
 }

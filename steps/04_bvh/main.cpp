@@ -46,7 +46,7 @@ int runTrace(const TraceOptions& o) {
     // --width 4: the binary tree collapsed to 4-wide nodes (bvh4.hpp); the collapse counts
     // as build time.
     Stopwatch collapseWatch;
-    Bvh4 wide = o.width == 4 ? collapseToBvh4(std::move(bvh)) : Bvh4{};
+    Bvh4 wide = o.width == 4 ? collapseToBvh4(bvh) : Bvh4{};
     if (o.width == 4) stats.buildMs += collapseWatch.seconds() * 1e3;
     double buildCpuSeconds = processCpuSeconds() - buildCpuStart;
     std::vector<TraceHit> hits;
@@ -125,7 +125,7 @@ int runCheck(const CheckOptions& o) {
         j[bvhBuilderName(builder)] = {{"differ", differ}, {"hits", hit}};
         total += differ;
         if (builder == BvhBuilder::BinnedSah) {  // and its 4-wide collapse (bvh4.hpp)
-            traceBatch(collapseToBvh4(std::move(bvh)), rays, hits, o.threads);
+            traceBatch(collapseToBvh4(bvh), rays, hits, o.threads);
             size_t differ4 = 0;
             for (size_t i = 0; i < rays.size(); ++i) differ4 += !hitsAgree(hits[i], reference[i]);
             j["sah-4wide"] = {{"differ", differ4}};

@@ -793,7 +793,7 @@ TEST_SUITE("bvh 4-wide") {
         Bvh4 wide = collapseToBvh4(binary);
         checkStructure4(wide, m.triangleCount());
         Bvh4Stats s = bvh4Stats(wide);
-        CHECK(s.leaves == binaryLeaves);  // leaves are kept, never split or merged
+        CHECK(s.leaves <= binaryLeaves);  // leaves are kept or merged, never split
         // n leaves in a full 4-ary tree need (n - 1) / 3 nodes; opening only inner nodes
         // leaves a few slots empty where a leaf sits beside leaves.
         CHECK(s.nodes < binary.nodes.size() / 2);

@@ -30,9 +30,10 @@ struct Collapser {
         return ranges[index] = r;
     }
 
-    // A binary node that becomes one leaf: a leaf, or a subtree of at most one packet's
-    // triangles (the four-triangle test costs about one triangle: a leaf of 4 beats a
-    // node over leaves of 2 and 2, the binned SAH's usual choice with equal costs).
+    // A binary node that becomes one leaf: a leaf, or a subtree of at most two packets'
+    // triangles. The four-triangle test costs about one triangle test, so the binned SAH's
+    // usual leaves of 2 (equal costs) left packets half full and nodes half useful; merged
+    // up to 8, motorbike diffuse rays ran about 1.2x faster than up to 4, the bunny alike.
     bool becomesLeaf(uint32_t index) const {
         return binary.nodes[index].isLeaf() ||
                (ranges[index].count != 0 && ranges[index].count <= kBvh4MergedLeafSize);
@@ -69,17 +70,20 @@ struct Collapser {
             // Open the inner child with the largest surface area (-1: flat and point boxes
             // have area 0 and are still opened).
             // (In double: in float the area of a box 1e20 across is infinite.)
+            // Failing that, a merged subtree is opened rather than a slot left empty: the
+            // node test costs the same, and smaller leaves test fewer triangles.
             int open = -1;
             double openArea = -1.0;
-            for (int i = 0; i < n; ++i) {
-                if (becomesLeaf(kids[i])) continue;
-                Bounds3d box(Vec3d(b[kids[i]].boundsMin), Vec3d(b[kids[i]].boundsMax));
-                double area = box.surfaceArea();
-                if (area > openArea) {
-                    open = i;
-                    openArea = area;
+            for (int pass = 0; pass < 2 && open < 0; ++pass)
+                for (int i = 0; i < n; ++i) {
+                    if (b[kids[i]].isLeaf() || (pass == 0 && becomesLeaf(kids[i]))) continue;
+                    Bounds3d box(Vec3d(b[kids[i]].boundsMin), Vec3d(b[kids[i]].boundsMax));
+                    double area = box.surfaceArea();
+                    if (area > openArea) {
+                        open = i;
+                        openArea = area;
+                    }
                 }
-            }
             if (open < 0) break;
             uint32_t opened = kids[open];
             kids[open] = b[opened].leftFirst;

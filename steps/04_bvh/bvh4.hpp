@@ -12,7 +12,7 @@
 // 2008, "Getting rid of packets"): a node starts with its two children, and while it has
 // fewer than four, the inner child with the largest surface area (the one a ray most likely
 // enters) is replaced by its own two children. The binary tree's leaves stay leaves, and a
-// subtree of at most 4 triangles becomes one leaf (one packet for the 4-triangle test);
+// subtree of at most 8 triangles becomes one leaf (two packets for the 4-triangle test);
 // leaves are stored as packets of four triangles, "structure of arrays" as well.
 //
 // Traversal is conservative exactly as the scalar one: the same margin-shifted origins,
@@ -71,7 +71,7 @@ struct Bvh4 {
 
 // Collapses a binary hierarchy: its leaves are kept, and so is any subtree of at most
 // kBvh4MergedLeafSize primitives, as one leaf; their slots are regrouped into packets.
-constexpr uint32_t kBvh4MergedLeafSize = 4;
+constexpr uint32_t kBvh4MergedLeafSize = 8;
 Bvh4 collapseToBvh4(const Bvh& binary);
 
 struct Bvh4Stats {

@@ -167,8 +167,11 @@ inline void prefetchChild(const Bvh4& bvh, uint32_t child, uint32_t count) {
 #endif
 }
 
-// Inner children push up to three entries per level, and the builders cap the depth at 64.
+// Inner children push up to three entries per level, and the builders cap the depth at
+// kTraversalStackSize / 2 = 64.
 constexpr int kBvh4StackSize = 256;
+// A 4-wide node may span one binary level on a path and still push 3 entries.
+static_assert(kBvh4StackSize > 3 * (kTraversalStackSize / 2) + 4, "the builders' depth cap");
 
 // Nearest hit, nearest child first, early out. intersectLeaf(first, count, tClosest) tests
 // a leaf's slots [first, first + count), lowers tClosest on a hit and returns the slot of

@@ -9,6 +9,7 @@
 #include <iostream>
 #include <nlohmann/json.hpp>
 
+#include "04_bvh/bvh4.hpp"
 #include "04_bvh/measure.hpp"
 #include "core/app.hpp"
 #include "core/orbit.hpp"
@@ -29,7 +30,7 @@ double processCpuSeconds() {
 
 struct TraceOptions {
     std::string mesh, rays, hits, builder = "sah";
-    int threads = 1, repeat = 1, bins = 16;
+    int threads = 1, repeat = 1, bins = 16, width = 2;
 };
 
 // `trace`: build, trace every ray (median of --repeat), write HITS.bin, one JSON line.
@@ -42,13 +43,21 @@ int runTrace(const TraceOptions& o) {
     BvhBuildStats stats;
     double buildCpuStart = processCpuSeconds();
     Bvh bvh = buildBvh(mesh, build, &stats);
+    // --width 4: the binary tree collapsed to 4-wide nodes (bvh4.hpp); the collapse counts
+    // as build time.
+    Stopwatch collapseWatch;
+    Bvh4 wide = o.width == 4 ? collapseToBvh4(bvh) : Bvh4{};
+    if (o.width == 4) stats.buildMs += collapseWatch.seconds() * 1e3;
     double buildCpuSeconds = processCpuSeconds() - buildCpuStart;
     std::vector<TraceHit> hits;
     std::vector<double> seconds, cpuSeconds;
     for (int i = 0; i < o.repeat; ++i) {
         Stopwatch watch;
         double cpuStart = processCpuSeconds();
-        traceBatch(bvh, rays, hits, o.threads);
+        if (o.width == 4)
+            traceBatch(wide, rays, hits, o.threads);
+        else
+            traceBatch(bvh, rays, hits, o.threads);
         seconds.push_back(watch.seconds());
         cpuSeconds.push_back(processCpuSeconds() - cpuStart);
     }
@@ -66,6 +75,7 @@ int runTrace(const TraceOptions& o) {
                         {"hits", hitCount},
                         {"threads", o.threads},
                         {"builder", bvhBuilderName(build.builder)},
+                        {"width", o.width},
                         {"bins", o.bins},
                         {"repeat", o.repeat},
                         {"nodes", stats.nodes},
@@ -114,6 +124,13 @@ int runCheck(const CheckOptions& o) {
         }
         j[bvhBuilderName(builder)] = {{"differ", differ}, {"hits", hit}};
         total += differ;
+        if (builder == BvhBuilder::BinnedSah) {  // and its 4-wide collapse (bvh4.hpp)
+            traceBatch(collapseToBvh4(bvh), rays, hits, o.threads);
+            size_t differ4 = 0;
+            for (size_t i = 0; i < rays.size(); ++i) differ4 += !hitsAgree(hits[i], reference[i]);
+            j["sah-4wide"] = {{"differ", differ4}};
+            total += differ4;
+        }
     }
     if (o.cracks > 0) {
         Table t = measureBvhCracks({{o.mesh, &mesh}}, o.cracks, o.seed);
@@ -177,6 +194,11 @@ int main(int argc, char** argv) {
             ->capture_default_str();
         traceCommand->add_option("--repeat", trace.repeat, "trace runs; the median is reported")
             ->check(CLI::Range(1, 1000))
+            ->capture_default_str();
+        traceCommand
+            ->add_option("--width", trace.width,
+                         "2: the binary tree; 4: its collapse to 4-wide nodes, SIMD traversal")
+            ->check(CLI::IsMember({2, 4}))
             ->capture_default_str();
         traceCommand->add_option("--bins", trace.bins, "binned SAH: bins per axis")
             ->check(CLI::Range(2, 256))

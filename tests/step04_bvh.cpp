@@ -407,6 +407,36 @@ TEST_SUITE("hard cases 04") {
             CHECK(traceNearest(buildBvh(flat, optionsFor(b)), awayFuzz).triangle == kNoPrimitive);
         }
     }
+    TEST_CASE("hard case: a triangle 3e38 away is hit at a finite t or missed") {
+        // Found by fuzz_rays. The scaled depth of a vertex 3e38 away times an edge function
+        // of about 4 overflows: t came out +inf, and t <= tmax = inf counted it as a hit
+        // at infinity, even with tmin beyond the true t. Decided in double now; a hit
+        // beyond the float range has no t and is a miss.
+        test::FpTrapsOff overflowOnPurpose;
+        Mesh m;
+        m.positions = {{-1.0f, -1.0f, -1.0f}, {1.0f, -1.0f, -1.0f}, {0.0f, 1.0f, -1.0f}};
+        m.triangles = {{0, 1, 2}};
+        const float far = 3e38f;
+        Ray down(Vec3(0.0f, 0.0f, far), Vec3(0.0f, 0.0f, -1.0f));
+        Ray pastIt = down;
+        pastIt.tmin = nextFloatUp(far);  // beyond the triangle's t (far + 1 rounds to far)
+        Ray slow(Vec3(0.0f, 0.0f, far), Vec3(0.0f, 0.0f, -0.5f));  // t = 6e38: no float
+        Bvh binary = buildBvh(m, optionsFor(BvhBuilder::SweepSah));
+        Bvh4 wide = collapseToBvh4(binary);
+        TraceHit hits[] = {traceBruteForce(m, down), traceNearest(binary, down),
+                           traceNearest(wide, down)};
+        for (const TraceHit& h : hits) {
+            CHECK(h.triangle == 0u);
+            CHECK(h.t == far);
+        }
+        for (const Ray& ray : {pastIt, slow}) {
+            CHECK(traceBruteForce(m, ray).triangle == kNoPrimitive);
+            CHECK(traceNearest(binary, ray).triangle == kNoPrimitive);
+            CHECK(traceNearest(wide, ray).triangle == kNoPrimitive);
+            CHECK_FALSE(traceOccluded(binary, ray));
+            CHECK_FALSE(traceOccluded(wide, ray));
+        }
+    }
 }
 
 TEST_SUITE("exercise 4.4") {

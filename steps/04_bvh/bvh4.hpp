@@ -301,7 +301,7 @@ inline float traversalMargin(const Ray& ray, const Bvh4& bvh) {
 // The watertight test (intersectLeafTriangle) on the four triangles of a packet at once:
 // the same operations in the same order per lane, so every lane's u, v, w, det and t are
 // bit for bit the scalar test's. Lanes the scalar test would decide in double (an edge
-// function exactly 0, a non-finite det, a scaled t below the normal range) are handed to
+// function exactly 0, a non-finite det, a scaled t outside the normal range) are handed to
 // it, one by one. Tests a leaf's slots [first, first + count) (first a multiple of 4) in
 // [ray.tmin, tClosest]; lowers tClosest to the nearest hit and returns its slot, or
 // kTraversalMiss. The sign test reads sign bits: for lanes whose u, v, w are all non-zero,
@@ -366,12 +366,17 @@ inline uint32_t intersectLeafPackets(Axes axes, const WatertightRay& r, const Wa
         const __m128 tScaled = _mm_add_ps(_mm_add_ps(_mm_mul_ps(u, _mm_mul_ps(r4.sz, aKz)),
                                                      _mm_mul_ps(v, _mm_mul_ps(r4.sz, bKz))),
                                           _mm_mul_ps(w, _mm_mul_ps(r4.sz, cKz)));
-        const __m128 tiny = _mm_castsi128_ps(_mm_cmplt_epi32(
-            _mm_and_si128(_mm_castps_si128(tScaled), absMask), _mm_set1_epi32(0x00800000)));
-        scalar = _mm_or_ps(scalar, _mm_and_ps(tiny, onward));
+        // Below the normal range or not finite (integer compares on the magnitude's bits).
+        const __m128i tScaledBits = _mm_and_si128(_mm_castps_si128(tScaled), absMask);
+        const __m128 outOfRange = _mm_castsi128_ps(
+            _mm_or_si128(_mm_cmplt_epi32(tScaledBits, _mm_set1_epi32(0x00800000)),
+                         _mm_cmpgt_epi32(tScaledBits, _mm_set1_epi32(0x7F7FFFFF))));
+        scalar = _mm_or_ps(scalar, _mm_and_ps(outOfRange, onward));
         const __m128 t = _mm_div_ps(tScaled, divisor);
         const __m128 tmax = _mm_set1_ps(tClosest);
-        __m128 hit = _mm_andnot_ps(tiny, onward);
+        const __m128 tFinite = _mm_castsi128_ps(_mm_cmplt_epi32(
+            _mm_and_si128(_mm_castps_si128(t), absMask), _mm_set1_epi32(0x7F800000)));
+        __m128 hit = _mm_and_ps(_mm_andnot_ps(outOfRange, onward), tFinite);
         hit = _mm_and_ps(hit, _mm_and_ps(_mm_cmpge_ps(t, r4.tmin), _mm_cmple_ps(t, tmax)));
         const uint32_t lanes = std::min(4u, first + count - base);
         const int live = (1 << lanes) - 1;  // the lanes after a leaf's end repeat its last

@@ -91,7 +91,8 @@ template <typename Axes>
     double det = u + v + w;
     if (det == 0.0 || !std::isfinite(det)) return false;
     float t = float((u * sz * av[kz] + v * sz * bv[kz] + w * sz * cv[kz]) / det);
-    if (!(t >= r.tmin && t <= tmax)) return false;
+    if (!(t >= r.tmin && t <= tmax && std::fabs(t) <= std::numeric_limits<float>::max()))
+        return false;
     tmax = t;
     if (uOut) *uOut = float(v / det);
     if (vOut) *vOut = float(w / det);
@@ -125,13 +126,17 @@ inline bool intersectLeafTriangle(Axes, const WatertightRay& r, const LeafTriang
     if (det == 0.0f) return false;
     float az = r.sz * a[kz], bz = r.sz * b[kz], cz = r.sz * c[kz];
     float tScaled = u * az + v * bz + w * cz;
-    // Below the normal range the products may have underflowed to zeros whose signs no
-    // longer add up (t = -0 for a triangle behind the ray, found by fuzz_rays with
-    // |d| = 1e28): decide in double, where they do not underflow.
-    if (std::fabs(tScaled) < std::numeric_limits<float>::min()) [[unlikely]]
+    // Outside the normal range the products may have underflowed to zeros whose signs no
+    // longer add up (t = -0 for a triangle behind the ray, |d| = 1e28) or overflowed (t =
+    // inf for a triangle 3e38 away): both found by fuzz_rays. Decide in double instead.
+    float magnitude = std::fabs(tScaled);
+    if (!(magnitude >= std::numeric_limits<float>::min() &&
+          magnitude <= std::numeric_limits<float>::max())) [[unlikely]]
         return intersectLeafTriangleDouble(Axes{}, r, tri, tmax, uOut, vOut);
     float t = tScaled / det;
-    if (!(t >= r.tmin && t <= tmax)) return false;
+    // A hit beyond the float range (t = +-inf) is a miss: HITS.bin has no t for it.
+    if (!(t >= r.tmin && t <= tmax && std::fabs(t) <= std::numeric_limits<float>::max()))
+        return false;
     tmax = t;
     if (uOut) *uOut = v / det;
     if (vOut) *vOut = w / det;

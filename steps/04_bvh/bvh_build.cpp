@@ -1,6 +1,10 @@
 // The builders: the recursive framework and the split rules (exercises 4.1 to 4.3).
 #include <algorithm>
+#include <cstdint>
 #include <numeric>
+#if defined(__linux__)
+#include <sys/mman.h>
+#endif
 
 #include "04_bvh/bvh.hpp"
 #include "core/timing.hpp"
@@ -115,25 +119,34 @@ size_t partitionBinnedSah(std::span<BuildPrimitive> prims, const Bounds3f& nodeB
         if (scale[axis] == 0.0f) continue;
         const SahBin* axisBins = bin[axis];
         // Sweep from the right: area and count right of each plane; then from the left.
+        // An empty bin changes neither (most bins of a small node are empty): its plane
+        // gives the same split as its neighbour's, so the sweeps skip the work for it.
         float rightArea[kMaxBins];
         uint32_t rightCount[kMaxBins];
         Vec3 lo(kInfinity<float>), hi(-kInfinity<float>);
         uint32_t count = 0;
+        float sideArea = 0.0f;
         for (int plane = bins - 1; plane > 0; --plane) {
-            count += axisBins[plane].count;
-            lo = glm::min(lo, axisBins[plane].lo);
-            hi = glm::max(hi, axisBins[plane].hi);
-            rightArea[plane] = count ? area(lo, hi) : 0.0f;
+            if (axisBins[plane].count > 0) {
+                count += axisBins[plane].count;
+                lo = glm::min(lo, axisBins[plane].lo);
+                hi = glm::max(hi, axisBins[plane].hi);
+                sideArea = area(lo, hi);
+            }
+            rightArea[plane] = sideArea;
             rightCount[plane] = count;
         }
         lo = Vec3(kInfinity<float>);
         hi = Vec3(-kInfinity<float>);
         count = 0;
         for (int plane = 1; plane < bins; ++plane) {
+            // Nothing right of this plane: nor of any further one.
+            if (rightCount[plane] == 0) break;
+            // The bin left of the plane is empty: the same split as the plane before.
+            if (axisBins[plane - 1].count == 0) continue;
             count += axisBins[plane - 1].count;
             lo = glm::min(lo, axisBins[plane - 1].lo);
             hi = glm::max(hi, axisBins[plane - 1].hi);
-            if (count == 0 || rightCount[plane] == 0) continue;
             float c = options.traversalCost + options.intersectionCost *
                                                   (area(lo, hi) * float(count) +
                                                    rightArea[plane] * float(rightCount[plane])) /
@@ -203,6 +216,25 @@ size_t partitionSweepSah(std::span<BuildPrimitive> prims, const Bounds3f& nodeBo
 
 namespace {
 
+// The build's large arrays (the primitives, the nodes, the leaf triangles: some 30 MB for
+// the motorbike) are first touched during the build, one 4 KiB page fault at a time:
+// a third of a one-shot build's CPU time on this machine (perf: 29,000 faults). Where
+// Linux offers transparent huge pages on request ("madvise" mode), ask for 2 MiB pages
+// over the whole 2 MiB blocks of the reserved (not yet touched) capacity: 512x fewer
+// faults, and fewer TLB misses when tracing. Advice only: any failure changes nothing.
+template <typename Vector>
+void reserveOnHugePages(Vector& v, size_t capacity) {
+    v.reserve(capacity);
+#if defined(__linux__) && defined(MADV_HUGEPAGE)
+    constexpr uintptr_t kHugePage = uintptr_t(2) << 20;
+    uintptr_t begin = reinterpret_cast<uintptr_t>(v.data());
+    uintptr_t end = begin + v.capacity() * sizeof(*v.data());
+    begin = (begin + kHugePage - 1) & ~(kHugePage - 1);
+    end &= ~(kHugePage - 1);
+    if (end > begin) madvise(reinterpret_cast<void*>(begin), end - begin, MADV_HUGEPAGE);
+#endif
+}
+
 class BvhBuildJob {
 public:
     BvhBuildJob(std::vector<BuildPrimitive>& prims, const BvhBuildOptions& options, Bvh& bvh)
@@ -211,7 +243,7 @@ public:
     void build() {
         bvh_.nodes.clear();
         if (prims_.empty()) return;
-        bvh_.nodes.reserve(2 * prims_.size());
+        reserveOnHugePages(bvh_.nodes, 2 * prims_.size());
         bvh_.nodes.emplace_back();
         buildNode(0, 0, prims_.size(), 0);
     }
@@ -294,8 +326,8 @@ Bvh buildFromPrimitives(std::vector<BuildPrimitive>& prims, const BvhBuildOption
     checkOptions(options);
     Bvh bvh;
     BvhBuildJob(prims, options, bvh).build();
-    bvh.primitiveIndices.resize(prims.size());
-    for (size_t i = 0; i < prims.size(); ++i) bvh.primitiveIndices[i] = prims[i].index;
+    reserveOnHugePages(bvh.primitiveIndices, prims.size());
+    for (const BuildPrimitive& p : prims) bvh.primitiveIndices.push_back(p.index);
     return bvh;
 }
 
@@ -310,9 +342,10 @@ void finishStats(const Bvh& bvh, const BvhBuildOptions& options, double ms, BvhB
 Bvh buildBvh(std::span<const Bounds3f> primitiveBounds, const BvhBuildOptions& options,
              BvhBuildStats* stats) {
     Stopwatch watch;
-    std::vector<BuildPrimitive> prims(primitiveBounds.size());
-    for (size_t i = 0; i < prims.size(); ++i)
-        prims[i] = {primitiveBounds[i], primitiveBounds[i].centroid(), uint32_t(i)};
+    std::vector<BuildPrimitive> prims;
+    reserveOnHugePages(prims, primitiveBounds.size());
+    for (size_t i = 0; i < primitiveBounds.size(); ++i)
+        prims.push_back({primitiveBounds[i], primitiveBounds[i].centroid(), uint32_t(i)});
     Bvh bvh = buildFromPrimitives(prims, options);
     finishStats(bvh, options, watch.milliseconds(), stats);
     return bvh;
@@ -322,18 +355,17 @@ Bvh buildBvh(const Mesh& mesh, const BvhBuildOptions& options, BvhBuildStats* st
     if (mesh.triangles.size() >= size_t(0xFFFFFFF0u))
         throw InputError("mesh has too many triangles for 32-bit indices");
     Stopwatch watch;
-    std::vector<BuildPrimitive> prims(mesh.triangles.size());
-    for (size_t i = 0; i < prims.size(); ++i) {
+    std::vector<BuildPrimitive> prims;
+    reserveOnHugePages(prims, mesh.triangles.size());
+    for (size_t i = 0; i < mesh.triangles.size(); ++i) {
         Bounds3f b;
         for (int k = 0; k < 3; ++k) b.extend(mesh.vertex(i, k));
-        prims[i] = {b, b.centroid(), uint32_t(i)};
+        prims.push_back({b, b.centroid(), uint32_t(i)});
     }
     Bvh bvh = buildFromPrimitives(prims, options);
-    bvh.leafTriangles.resize(prims.size());
-    for (size_t s = 0; s < prims.size(); ++s) {
-        uint32_t t = bvh.primitiveIndices[s];
-        bvh.leafTriangles[s] = {mesh.vertex(t, 0), mesh.vertex(t, 1), mesh.vertex(t, 2)};
-    }
+    reserveOnHugePages(bvh.leafTriangles, prims.size());
+    for (uint32_t t : bvh.primitiveIndices)
+        bvh.leafTriangles.push_back({mesh.vertex(t, 0), mesh.vertex(t, 1), mesh.vertex(t, 2)});
     finishStats(bvh, options, watch.milliseconds(), stats);
     return bvh;
 }

@@ -5,6 +5,9 @@
 #if defined(__linux__)
 #include <sys/mman.h>
 #endif
+#if defined(__SSE2__)
+#include <immintrin.h>
+#endif
 
 #include "04_bvh/bvh.hpp"
 #include "core/timing.hpp"
@@ -66,15 +69,79 @@ inline float component(const Vec3& v, int axis) {
     return (&v.x)[axis];
 }
 
-struct SahBin {
-    Vec3 lo, hi;  // bounds of the primitives in the bin
-    uint32_t count;
-};
-
 inline float area(const Vec3& lo, const Vec3& hi) {
     Vec3 d = hi - lo;
     return 2.0f * (d.x * d.y + d.y * d.z + d.z * d.x);
 }
+
+// Bounds that a build loop extends once per primitive: the framework's pass over a node
+// and the binned SAH's bins. With SSE each of min and max is one 4-wide register (x, y,
+// z and a 4th lane that is never read), so extending by a primitive's box is one min and
+// one max instead of six scalar operations; elsewhere three floats, the same results.
+// Trivial on purpose: an array of 768 bins costs nothing until a bin is set to empty().
+struct PackedBounds {
+#if defined(__SSE2__)
+    __m128 lo, hi;
+
+    static PackedBounds empty() {
+        return {_mm_set1_ps(kInfinity<float>), _mm_set1_ps(-kInfinity<float>)};
+    }
+    // By the primitive's box: bounds.min and bounds.max read as 4 floats each (the 4th is
+    // the next member's, inside the same BuildPrimitive, and ends in the unused lane).
+    void extend(const BuildPrimitive& p) {
+        lo = _mm_min_ps(lo, _mm_loadu_ps(&p.bounds.min.x));
+        hi = _mm_max_ps(hi, _mm_loadu_ps(&p.bounds.max.x));
+    }
+    // By the primitive's centroid (the 4th lane a copy of z, not the index's bits).
+    void extendByCentroid(const BuildPrimitive& p) {
+        __m128 c = _mm_loadu_ps(&p.centroid.x);
+        c = _mm_shuffle_ps(c, c, _MM_SHUFFLE(2, 2, 1, 0));
+        lo = _mm_min_ps(lo, c);
+        hi = _mm_max_ps(hi, c);
+    }
+    void extend(const PackedBounds& b) {
+        lo = _mm_min_ps(lo, b.lo);
+        hi = _mm_max_ps(hi, b.hi);
+    }
+    Bounds3f bounds() const {
+        alignas(16) float l[4], h[4];
+        _mm_store_ps(l, lo);
+        _mm_store_ps(h, hi);
+        return {Vec3(l[0], l[1], l[2]), Vec3(h[0], h[1], h[2])};
+    }
+#else
+    Vec3 lo, hi;
+
+    static PackedBounds empty() {
+        return {Vec3(kInfinity<float>), Vec3(-kInfinity<float>)};
+    }
+    void extend(const BuildPrimitive& p) {
+        lo = glm::min(lo, p.bounds.min);
+        hi = glm::max(hi, p.bounds.max);
+    }
+    void extendByCentroid(const BuildPrimitive& p) {
+        lo = glm::min(lo, p.centroid);
+        hi = glm::max(hi, p.centroid);
+    }
+    void extend(const PackedBounds& b) {
+        lo = glm::min(lo, b.lo);
+        hi = glm::max(hi, b.hi);
+    }
+    Bounds3f bounds() const {
+        return {lo, hi};
+    }
+#endif
+    // Only for bounds that contain something (an empty box has no meaningful area).
+    float surfaceArea() const {
+        Bounds3f b = bounds();
+        return area(b.min, b.max);
+    }
+};
+
+struct SahBin {
+    PackedBounds bounds;  // of the primitives in the bin
+    uint32_t count;
+};
 
 }  // namespace
 
@@ -103,16 +170,14 @@ size_t partitionBinnedSah(std::span<BuildPrimitive> prims, const Bounds3f& nodeB
     if (scale[0] == 0.0f && scale[1] == 0.0f && scale[2] == 0.0f) return 0;
     SahBin bin[3][kMaxBins];
     for (int axis = 0; axis < 3; ++axis)
-        for (int b = 0; b < bins; ++b)
-            bin[axis][b] = {Vec3(kInfinity<float>), Vec3(-kInfinity<float>), 0};
+        for (int b = 0; b < bins; ++b) bin[axis][b] = {PackedBounds::empty(), 0};
     for (const BuildPrimitive& p : prims) {
         for (int axis = 0; axis < 3; ++axis) {
             int b =
                 std::min(bins - 1, int((component(p.centroid, axis) - lowest[axis]) * scale[axis]));
             SahBin& into = bin[axis][b];
             into.count++;
-            into.lo = glm::min(into.lo, p.bounds.min);
-            into.hi = glm::max(into.hi, p.bounds.max);
+            into.bounds.extend(p);
         }
     }
     for (int axis = 0; axis < 3; ++axis) {
@@ -123,21 +188,19 @@ size_t partitionBinnedSah(std::span<BuildPrimitive> prims, const Bounds3f& nodeB
         // gives the same split as its neighbour's, so the sweeps skip the work for it.
         float rightArea[kMaxBins];
         uint32_t rightCount[kMaxBins];
-        Vec3 lo(kInfinity<float>), hi(-kInfinity<float>);
+        PackedBounds side = PackedBounds::empty();
         uint32_t count = 0;
         float sideArea = 0.0f;
         for (int plane = bins - 1; plane > 0; --plane) {
             if (axisBins[plane].count > 0) {
                 count += axisBins[plane].count;
-                lo = glm::min(lo, axisBins[plane].lo);
-                hi = glm::max(hi, axisBins[plane].hi);
-                sideArea = area(lo, hi);
+                side.extend(axisBins[plane].bounds);
+                sideArea = side.surfaceArea();
             }
             rightArea[plane] = sideArea;
             rightCount[plane] = count;
         }
-        lo = Vec3(kInfinity<float>);
-        hi = Vec3(-kInfinity<float>);
+        side = PackedBounds::empty();
         count = 0;
         for (int plane = 1; plane < bins; ++plane) {
             // Nothing right of this plane: nor of any further one.
@@ -145,10 +208,9 @@ size_t partitionBinnedSah(std::span<BuildPrimitive> prims, const Bounds3f& nodeB
             // The bin left of the plane is empty: the same split as the plane before.
             if (axisBins[plane - 1].count == 0) continue;
             count += axisBins[plane - 1].count;
-            lo = glm::min(lo, axisBins[plane - 1].lo);
-            hi = glm::max(hi, axisBins[plane - 1].hi);
+            side.extend(axisBins[plane - 1].bounds);
             float c = options.traversalCost + options.intersectionCost *
-                                                  (area(lo, hi) * float(count) +
+                                                  (side.surfaceArea() * float(count) +
                                                    rightArea[plane] * float(rightCount[plane])) /
                                                   nodeArea;
             if (c < cost) {
@@ -255,12 +317,12 @@ private:
     }
 
     void buildNode(uint32_t nodeIndex, size_t begin, size_t end, int depth) {
-        Bounds3f bounds, centroids;
+        PackedBounds packedBounds = PackedBounds::empty(), packedCentroids = PackedBounds::empty();
         for (size_t i = begin; i < end; ++i) {
-            bounds.extend(prims_[i].bounds.min);
-            bounds.extend(prims_[i].bounds.max);
-            centroids.extend(prims_[i].centroid);
+            packedBounds.extend(prims_[i]);
+            packedCentroids.extendByCentroid(prims_[i]);
         }
+        Bounds3f bounds = packedBounds.bounds(), centroids = packedCentroids.bounds();
         size_t n = end - begin;
         BvhNode& node = bvh_.nodes[nodeIndex];
         node.boundsMin = bounds.min;

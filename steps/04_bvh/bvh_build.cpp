@@ -183,40 +183,38 @@ size_t partitionBinnedSah(std::span<BuildPrimitive> prims, const Bounds3f& nodeB
     for (int axis = 0; axis < 3; ++axis) {
         if (scale[axis] == 0.0f) continue;
         const SahBin* axisBins = bin[axis];
-        // Sweep from the right: area and count right of each plane; then from the left.
-        // An empty bin changes neither (most bins of a small node are empty): its plane
-        // gives the same split as its neighbour's, so the sweeps skip the work for it.
+        // Only the occupied bins matter: a plane between empty bins repeats its neighbour's
+        // split, and a small node fills few of its bins. List them (without a branch).
+        int occupied[kMaxBins], used = 0;
+        for (int b = 0; b < bins; ++b) {
+            occupied[used] = b;
+            used += axisBins[b].count > 0 ? 1 : 0;
+        }
+        // Sweep from the right: area and count of the occupied bins j.. (the primitives
+        // right of the plane before bin occupied[j]); then from the left, pricing each plane.
         float rightArea[kMaxBins];
         uint32_t rightCount[kMaxBins];
         PackedBounds side = PackedBounds::empty();
         uint32_t count = 0;
-        float sideArea = 0.0f;
-        for (int plane = bins - 1; plane > 0; --plane) {
-            if (axisBins[plane].count > 0) {
-                count += axisBins[plane].count;
-                side.extend(axisBins[plane].bounds);
-                sideArea = side.surfaceArea();
-            }
-            rightArea[plane] = sideArea;
-            rightCount[plane] = count;
+        for (int j = used - 1; j > 0; --j) {
+            count += axisBins[occupied[j]].count;
+            side.extend(axisBins[occupied[j]].bounds);
+            rightArea[j] = side.surfaceArea();
+            rightCount[j] = count;
         }
         side = PackedBounds::empty();
         count = 0;
-        for (int plane = 1; plane < bins; ++plane) {
-            // Nothing right of this plane: nor of any further one.
-            if (rightCount[plane] == 0) break;
-            // The bin left of the plane is empty: the same split as the plane before.
-            if (axisBins[plane - 1].count == 0) continue;
-            count += axisBins[plane - 1].count;
-            side.extend(axisBins[plane - 1].bounds);
+        for (int j = 1; j < used; ++j) {
+            count += axisBins[occupied[j - 1]].count;
+            side.extend(axisBins[occupied[j - 1]].bounds);
             float c = options.traversalCost + options.intersectionCost *
                                                   (side.surfaceArea() * float(count) +
-                                                   rightArea[plane] * float(rightCount[plane])) /
+                                                   rightArea[j] * float(rightCount[j])) /
                                                   nodeArea;
             if (c < cost) {
                 cost = c;
                 bestAxis = axis;
-                bestPlane = plane;
+                bestPlane = occupied[j];  // bins below this one go left
             }
         }
     }

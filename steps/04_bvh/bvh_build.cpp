@@ -155,6 +155,20 @@ size_t partitionBinnedSah(std::span<BuildPrimitive> prims, const Bounds3f& nodeB
     float nodeArea = nodeBounds.surfaceArea();
     // A node without area (all primitives on one line) gives no guidance: no split.
     if (!(nodeArea > 0.0f)) return 0;
+    // Two primitives (a third of the calls): the only split puts one on each side; it is
+    // the plane the bins would find on the first axis where the centroids differ.
+    if (prims.size() == 2) {
+        for (int axis = 0; axis < 3; ++axis) {
+            float a = component(prims[0].centroid, axis), b = component(prims[1].centroid, axis);
+            if (a == b) continue;
+            if (b < a) std::swap(prims[0], prims[1]);
+            cost = options.traversalCost +
+                   options.intersectionCost *
+                       (prims[0].bounds.surfaceArea() + prims[1].bounds.surfaceArea()) / nodeArea;
+            return 1;
+        }
+        return 0;
+    }
     int bestAxis = -1, bestPlane = 0;
     // Per axis: the bin scale (0 for an axis with zero extent: nothing to split there, and
     // a division by zero otherwise). All three axes are binned in one pass over the

@@ -31,6 +31,11 @@ struct CameraT {
     T fovYDegrees = T(60);
     T aspect = T(4) / T(3);  // width / height
 
+    // The camera at `eye` looking at `target`.
+    static CameraT lookingAt(Vec3T<T> eye, Vec3T<T> target, Vec3T<T> up, T fovYDegrees, T aspect) {
+        return {eye, target - eye, up, fovYDegrees, aspect};
+    }
+
     void validate() const {
         if (!isFinite(eye)) throw std::invalid_argument("camera eye is not finite");
         if (!isFinite(view) || isZero(view))

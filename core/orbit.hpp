@@ -5,6 +5,7 @@
 #include <SDL2/SDL_keycode.h>
 
 #include <algorithm>
+#include <functional>
 #include <string>
 #include <vector>
 
@@ -59,6 +60,23 @@ public:
         }
     }
     void onDrag(float dx, float dy) { rotate(dx * 0.005f, -dy * 0.005f); }
+
+    // Adds the orbit to a step's window: its keys after the step's own (set cb.keys and
+    // cb.onKey first; a key the step uses never reaches the orbit) and the mouse drag.
+    // `moved` runs whenever the camera moved.
+    void addTo(WindowCallbacks& cb, std::function<void()> moved) {
+        for (const KeyBinding& k : keys()) cb.keys.push_back(k);
+        cb.onKey = [stepKeys = cb.onKey, this, moved](int key) {
+            if (stepKeys && stepKeys(key)) return true;
+            if (!onKey(key)) return false;
+            moved();
+            return true;
+        };
+        cb.onMouseDrag = [this, moved](float dx, float dy) {
+            onDrag(dx, dy);
+            moved();
+        };
+    }
 
 private:
     void rotate(float yaw, float pitch) {

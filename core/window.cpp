@@ -387,6 +387,12 @@ void runWindow(const WindowOptions& options, WindowCallbacks& callbacks) {
     // Escape and Q quit unless the step used the key (e.g. to cancel something).
     auto pressKey = [&](SDL_Keycode key) {
         bool used = callbacks.onKey ? callbacks.onKey(int(key)) : false;
+        // A key the window lists must do something: scripted runs (the tests) say so.
+        bool listed = std::any_of(callbacks.keys.begin(), callbacks.keys.end(),
+                                  [&](const KeyBinding& b) { return b.key == key; });
+        if (scripted && listed && !used)
+            throw std::logic_error(std::string("the window lists key '") + SDL_GetKeyName(key) +
+                                   "' but it did nothing");
         return !used && (key == SDLK_ESCAPE || key == SDLK_q);
     };
 

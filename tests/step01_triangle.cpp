@@ -306,63 +306,35 @@ TEST_SUITE("program 01") {
 
     TEST_CASE("headless render writes a PNG of the requested size") {
         test::TempDir dir;
-        auto run = test::runProgram(
-            program, "--headless --scene sh1 --width 64 --height 40 --out a.png", dir);
-        INFO(run.err);
-        REQUIRE(run.exitCode == 0);
-        CHECK(test::pngSize(dir.file("a.png")) == std::pair{64, 40});
+        test::runHeadless(program, dir, 64, 40, "--scene sh1");
     }
     TEST_CASE("measurements: the JSON report has the speed and crack tables") {
         test::TempDir dir;
-        auto run = test::runProgram(program,
-                                    "--headless --scene sh1 --width 32 --height 24 --out a.png "
-                                    "--measure --crack-rays 2000 --report r.json",
-                                    dir);
-        INFO(run.err);
-        REQUIRE(run.exitCode == 0);
-        std::string json = test::readText(dir.file("r.json"));
-        CHECK(json.find("\"triangle_speed\"") != std::string::npos);
-        CHECK(json.find("\"cracks\"") != std::string::npos);
+        auto run = test::runHeadless(program, dir, 32, 24,
+                                     "--scene sh1 --measure --crack-rays 2000 --report r.json");
+        test::checkReportTables(dir.file("r.json"), {"triangle_speed", "cracks"});
         CHECK(test::pngSize(dir.file("a-disagree.png")) == std::pair{32, 24});
         CHECK(run.out.find("watertight float") != std::string::npos);
     }
     TEST_CASE("window: scripted frames with key presses under the offscreen video driver") {
         test::TempDir dir;
-        auto run =
-            test::runProgram(program,
-                             "--scene sh1 --width 64 --height 48 --frames 4 --keys t,m,t,Left "
-                             "--screenshot shot.png",
-                             dir, test::kWindowEnvironment);
-        INFO(run.err);
-        REQUIRE(run.exitCode == 0);
-        CHECK(test::pngSize(dir.file("shot.png")).first > 0);
+        test::runWindowScript(program, dir, "--scene sh1 --width 64 --height 48", 4, "t,m,t,Left");
     }
     TEST_CASE("bad input: one clear line and a non-zero exit") {
         test::TempDir dir;
         std::ofstream(dir.file("letters.obj")) << "v 0 0 0\nv 1 x 0\nv 0 1 0\nf 1 2 3\n";
         std::ofstream(dir.file("range.obj")) << "v 0 0 0\nv 1 0 0\nv 0 1 0\nf 1 2 7\n";
         std::ofstream(dir.file("empty.obj")) << "";
-        struct Case {
-            std::string args, expect;
-            int code;
-        };
-        for (const Case& c :
-             std::vector<Case>{{"--scene missing.obj", "no such file", 1},
-                               {"--scene letters.obj", "not a number", 1},
-                               {"--scene range.obj", "out of range", 1},
-                               {"--scene empty.obj", "empty", 1},
-                               {"--scene nosuchscene", "unknown scene", 1},
-                               {"--frobnicate", "frobnicate", 2},
-                               {"--width 0", "width", 2},
-                               {"--eye 1,2,3 --look 1,2,3", "view direction is zero", 1},
-                               {"--up 0,0,0", "up vector is zero", 1},
-                               {"--eye 1,2", "expected X,Y,Z", 1}}) {
-            INFO(c.args);
-            auto run = test::runProgram(program, "--headless --out bad.png " + c.args, dir);
-            CHECK(run.exitCode == c.code);
-            CHECK(test::lineCount(run.err) == 1);
-            CHECK(run.err.find(c.expect) != std::string::npos);
-            CHECK_FALSE(std::filesystem::exists(dir.file("bad.png")));
-        }
+        test::checkBadInput(program, dir,
+                            {{"--scene missing.obj", "no such file", 1},
+                             {"--scene letters.obj", "not a number", 1},
+                             {"--scene range.obj", "out of range", 1},
+                             {"--scene empty.obj", "empty", 1},
+                             {"--scene nosuchscene", "unknown scene", 1},
+                             {"--frobnicate", "frobnicate", 2},
+                             {"--width 0", "width", 2},
+                             {"--eye 1,2,3 --look 1,2,3", "view direction is zero", 1},
+                             {"--up 0,0,0", "up vector is zero", 1},
+                             {"--eye 1,2", "expected X,Y,Z", 1}});
     }
 }

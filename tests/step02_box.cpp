@@ -294,63 +294,32 @@ TEST_SUITE("program 02") {
     }
     TEST_CASE("headless render writes a PNG of the requested size") {
         test::TempDir dir;
-        auto run = test::runProgram(
-            program, "--headless --width 64 --height 40 --out a.png --method planes", dir);
-        INFO(run.err);
-        REQUIRE(run.exitCode == 0);
-        CHECK(test::pngSize(dir.file("a.png")) == std::pair{64, 40});
+        test::runHeadless(program, dir, 64, 40, "--method planes");
     }
     TEST_CASE("a core scene drawn as boxes") {
         test::TempDir dir;
-        auto run = test::runProgram(
-            program, "--headless --scene sh1 --width 32 --height 24 --out s.png", dir);
-        INFO(run.err);
-        REQUIRE(run.exitCode == 0);
-        CHECK(test::pngSize(dir.file("s.png")) == std::pair{32, 24});
+        test::runHeadless(program, dir, 32, 24, "--scene sh1");
     }
     TEST_CASE("measurements: the JSON report has the speed and disagreement tables") {
         test::TempDir dir;
-        auto run = test::runProgram(program,
-                                    "--headless --width 32 --height 24 --out a.png --measure "
-                                    "--rays-per-box 20 --report r.json",
-                                    dir);
-        INFO(run.err);
-        REQUIRE(run.exitCode == 0);
-        std::string json = test::readText(dir.file("r.json"));
-        for (const char* id : {"\"box_speed\"", "\"box_accuracy\"", "\"method_disagreement\""}) {
-            INFO(id);
-            CHECK(json.find(id) != std::string::npos);
-        }
+        auto run =
+            test::runHeadless(program, dir, 32, 24, "--measure --rays-per-box 20 --report r.json");
+        test::checkReportTables(dir.file("r.json"),
+                                {"box_speed", "box_accuracy", "method_disagreement"});
         CHECK(test::pngSize(dir.file("a-disagree.png")) == std::pair{32, 24});
         CHECK(run.out.find("six planes") != std::string::npos);
     }
     TEST_CASE("window: scripted frames with key presses under the offscreen video driver") {
         test::TempDir dir;
-        auto run = test::runProgram(
-            program, "--width 64 --height 48 --frames 4 --keys m,d,m,Left --screenshot shot.png",
-            dir, test::kWindowEnvironment);
-        INFO(run.err);
-        REQUIRE(run.exitCode == 0);
-        CHECK(test::pngSize(dir.file("shot.png")).first > 0);
+        test::runWindowScript(program, dir, "--width 64 --height 48", 4, "m,d,m,Left");
     }
     TEST_CASE("bad input: one clear line and a non-zero exit") {
         test::TempDir dir;
-        struct Case {
-            std::string args, expect;
-            int code;
-        };
-        for (const Case& c :
-             std::vector<Case>{{"--scene nosuchscene", "unknown scene", 1},
-                               {"--method cubes", "method", 2},
-                               {"--frobnicate", "frobnicate", 2},
-                               {"--rays-per-box 0", "rays-per-box", 2},
-                               {"--eye 1,2,3 --look 1,2,3", "view direction is zero", 1}}) {
-            INFO(c.args);
-            auto run = test::runProgram(program, "--headless --out bad.png " + c.args, dir);
-            CHECK(run.exitCode == c.code);
-            CHECK(test::lineCount(run.err) == 1);
-            CHECK(run.err.find(c.expect) != std::string::npos);
-            CHECK_FALSE(std::filesystem::exists(dir.file("bad.png")));
-        }
+        test::checkBadInput(program, dir,
+                            {{"--scene nosuchscene", "unknown scene", 1},
+                             {"--method cubes", "method", 2},
+                             {"--frobnicate", "frobnicate", 2},
+                             {"--rays-per-box 0", "rays-per-box", 2},
+                             {"--eye 1,2,3 --look 1,2,3", "view direction is zero", 1}});
     }
 }

@@ -394,56 +394,30 @@ TEST_SUITE("program 03") {
 
     TEST_CASE("headless render writes a PNG of the requested size") {
         test::TempDir dir;
-        auto run =
-            test::runProgram(program, "--headless --width 64 --height 40 --out a.png" + small, dir);
-        INFO(run.err);
-        REQUIRE(run.exitCode == 0);
-        CHECK(test::pngSize(dir.file("a.png")) == std::pair{64, 40});
+        test::runHeadless(program, dir, 64, 40, small);
     }
     TEST_CASE("measurements: the JSON report has the slab and pre-test tables") {
         test::TempDir dir;
-        auto run = test::runProgram(
-            program,
-            "--headless --width 32 --height 24 --out a.png --measure --hard-rays 50 "
-            "--measure-width 12 --measure-height 8 --scene spheres --report r.json",
-            dir);
-        INFO(run.err);
-        REQUIRE(run.exitCode == 0);
-        std::string json = test::readText(dir.file("r.json"));
-        for (const char* id : {"\"slab_accuracy\"", "\"slab_hard_rays\"", "\"pretest\""}) {
-            INFO(id);
-            CHECK(json.find(id) != std::string::npos);
-        }
-        CHECK(json.find("\"pretest_pixels_differing\": 0") != std::string::npos);
+        auto run = test::runHeadless(program, dir, 32, 24,
+                                     "--measure --hard-rays 50 --measure-width 12 "
+                                     "--measure-height 8 --scene spheres --report r.json");
+        test::checkReportTables(dir.file("r.json"), {"slab_accuracy", "slab_hard_rays", "pretest"});
+        CHECK(test::readText(dir.file("r.json")).find("\"pretest_pixels_differing\": 0") !=
+              std::string::npos);
         CHECK(run.out.find("conservative (3.7)") != std::string::npos);
     }
     TEST_CASE("window: scripted frames with key presses under the offscreen video driver") {
         test::TempDir dir;
-        auto run = test::runProgram(program,
-                                    "--scene spheres --width 64 --height 48 --frames 4 --keys "
-                                    "b,Left,b --screenshot shot.png",
-                                    dir, test::kWindowEnvironment);
-        INFO(run.err);
-        REQUIRE(run.exitCode == 0);
-        CHECK(test::pngSize(dir.file("shot.png")).first > 0);
+        test::runWindowScript(program, dir, "--scene spheres --width 64 --height 48", 4,
+                              "b,Left,b");
     }
     TEST_CASE("bad input: one clear line and a non-zero exit") {
         test::TempDir dir;
-        struct Case {
-            std::string args, expect;
-            int code;
-        };
-        for (const Case& c : std::vector<Case>{{"--scene nosuchscene", "unknown scene", 1},
-                                               {"--pretest maybe", "pretest", 2},
-                                               {"--spheres -3", "spheres", 2},
-                                               {"--frobnicate", "frobnicate", 2},
-                                               {"--scene missing.obj", "no such file", 1}}) {
-            INFO(c.args);
-            auto run = test::runProgram(program, "--headless --out bad.png " + c.args, dir);
-            CHECK(run.exitCode == c.code);
-            CHECK(test::lineCount(run.err) == 1);
-            CHECK(run.err.find(c.expect) != std::string::npos);
-            CHECK_FALSE(std::filesystem::exists(dir.file("bad.png")));
-        }
+        test::checkBadInput(program, dir,
+                            {{"--scene nosuchscene", "unknown scene", 1},
+                             {"--pretest maybe", "pretest", 2},
+                             {"--spheres -3", "spheres", 2},
+                             {"--frobnicate", "frobnicate", 2},
+                             {"--scene missing.obj", "no such file", 1}});
     }
 }

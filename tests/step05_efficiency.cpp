@@ -638,10 +638,7 @@ TEST_SUITE("program 05") {
 
     TEST_CASE("headless render writes the image and every preview") {
         test::TempDir dir;
-        auto run = test::runProgram(program, "--headless --width 64 --height 40 --out a.png", dir);
-        INFO(run.err);
-        REQUIRE(run.exitCode == 0);
-        CHECK(test::pngSize(dir.file("a.png")) == std::pair{64, 40});
+        auto run = test::runHeadless(program, dir, 64, 40);
         for (const char* p : {"a-depth.png", "a-depth-material.png", "a-no-recursion.png",
                               "a-limited-recursion.png", "a-half-resolution.png", "a-adaptive.png"})
             CHECK(test::pngSize(dir.file(p)) == std::pair{64, 40});
@@ -649,73 +646,42 @@ TEST_SUITE("program 05") {
     }
     TEST_CASE("measurements: the JSON report has every lab table") {
         test::TempDir dir;
-        auto run = test::runProgram(program,
-                                    "--headless --scene sh1 --width 32 --height 24 --out a.png "
-                                    "--measure --quick --repeats 1 --report r.json",
-                                    dir);
-        INFO(run.err);
-        REQUIRE(run.exitCode == 0);
-        std::string json = test::readText(dir.file("r.json"));
-        for (const char* id :
-             {"measuring", "float_double", "acne", "sincos", "early_out", "light_radius", "effects",
-              "precalc", "expensive_ops", "rsqrt", "threads", "antialiasing", "previews", "total"})
-            CHECK_MESSAGE(json.find(std::string("\"") + id + "\"") != std::string::npos, id);
+        auto run = test::runHeadless(program, dir, 32, 24,
+                                     "--scene sh1 --measure --quick --repeats 1 --report r.json");
+        test::checkReportTables(
+            dir.file("r.json"),
+            {"measuring", "float_double", "acne", "sincos", "early_out", "light_radius", "effects",
+             "precalc", "expensive_ops", "rsqrt", "threads", "antialiasing", "previews", "total"});
         CHECK(run.out.find("table nearest 3600") != std::string::npos);
     }
     TEST_CASE("window: previews and refinement under the offscreen video driver") {
         test::TempDir dir;
-        auto run = test::runProgram(program,
-                                    "--width 64 --height 48 --frames 8 --keys 1,2,Left,3,4,5,6,0 "
-                                    "--screenshot shot.png",
-                                    dir, test::kWindowEnvironment);
-        INFO(run.err);
-        REQUIRE(run.exitCode == 0);
-        CHECK(test::pngSize(dir.file("shot.png")).first > 0);
+        test::runWindowScript(program, dir, "--width 64 --height 48", 8, "1,2,Left,3,4,5,6,0");
     }
     TEST_CASE("window: the photograph is saved and its path printed") {
         test::TempDir dir;
-        auto run = test::runProgram(program,
-                                    "--width 48 --height 36 --photo-spp 4 --frames 40 --keys p "
-                                    "--screenshot shot.png",
-                                    dir, test::kWindowEnvironment);
-        INFO(run.err);
-        REQUIRE(run.exitCode == 0);
+        auto run =
+            test::runWindowScript(program, dir, "--width 48 --height 36 --photo-spp 4", 40, "p");
         CHECK(run.out.find("photograph saved to 05_efficiency-photo-1.png") != std::string::npos);
         CHECK(test::pngSize(dir.file("05_efficiency-photo-1.png")) == std::pair{48, 36});
     }
     TEST_CASE("window: Escape cancels the photograph and does not quit") {
         test::TempDir dir;
-        auto run =
-            test::runProgram(program,
-                             "--width 320 --height 240 --photo-spp 64 --frames 4 --keys p,Escape,1 "
-                             "--screenshot shot.png",
-                             dir, test::kWindowEnvironment);
-        INFO(run.err);
-        REQUIRE(run.exitCode == 0);
+        // The screenshot (checked by runWindowScript): the window ran to its last frame.
+        auto run = test::runWindowScript(program, dir, "--width 320 --height 240 --photo-spp 64", 4,
+                                         "p,Escape,1");
         CHECK(run.out.find("photograph cancelled") != std::string::npos);
         CHECK_FALSE(std::filesystem::exists(dir.file("05_efficiency-photo-1.png")));
-        CHECK(test::pngSize(dir.file("shot.png")).first > 0);  // the window ran to its last frame
     }
     TEST_CASE("bad input: one clear line and a non-zero exit") {
         test::TempDir dir;
-        struct Case {
-            std::string args, expect;
-            int code;
-        };
-        for (const Case& c :
-             std::vector<Case>{{"--scene missing.obj", "no such file", 1},
-                               {"--scene nosuchscene", "unknown scene", 1},
-                               {"--frobnicate", "frobnicate", 2},
-                               {"--width 0", "width", 2},
-                               {"--repeats 0", "repeats", 2},
-                               {"--budget-ms 0", "budget", 2},
-                               {"--eye 1,2,3 --look 1,2,3", "view direction is zero", 1}}) {
-            INFO(c.args);
-            auto run = test::runProgram(program, "--headless --out bad.png " + c.args, dir);
-            CHECK(run.exitCode == c.code);
-            CHECK(test::lineCount(run.err) == 1);
-            CHECK(run.err.find(c.expect) != std::string::npos);
-            CHECK_FALSE(std::filesystem::exists(dir.file("bad.png")));
-        }
+        test::checkBadInput(program, dir,
+                            {{"--scene missing.obj", "no such file", 1},
+                             {"--scene nosuchscene", "unknown scene", 1},
+                             {"--frobnicate", "frobnicate", 2},
+                             {"--width 0", "width", 2},
+                             {"--repeats 0", "repeats", 2},
+                             {"--budget-ms 0", "budget", 2},
+                             {"--eye 1,2,3 --look 1,2,3", "view direction is zero", 1}});
     }
 }

@@ -19,16 +19,6 @@ using boxes::test::checkVec;
 
 namespace {
 
-Camera makeCamera(Vec3 eye, Vec3 look, Vec3 up, float fov, float aspect) {
-    Camera c;
-    c.eye = eye;
-    c.view = look - eye;
-    c.up = up;
-    c.fovYDegrees = fov;
-    c.aspect = aspect;
-    return c;
-}
-
 // Test-local fill-rule rasterizer: our own exact edge function, the student's top-left rule.
 int64_t localEdge(FixedPoint2 a, FixedPoint2 b, FixedPoint2 p) {
     return (b.x - a.x) * (p.y - a.y) - (b.y - a.y) * (p.x - a.x);
@@ -120,7 +110,7 @@ void checkAgreement(const Agreement& a, double minimum) {
 TEST_SUITE("exercise 6.1") {
     TEST_CASE("a point through view and clip space") {
         // Eye (0,0,5) looking down -z, fov 90 (f = 1), aspect 2, near 1, far 11.
-        Camera c = makeCamera(Vec3(0, 0, 5), Vec3(0, 0, 0), Vec3(0, 1, 0), 90.0f, 2.0f);
+        Camera c = Camera::lookingAt(Vec3(0, 0, 5), Vec3(0, 0, 0), Vec3(0, 1, 0), 90.0f, 2.0f);
         Vec4d view = viewMatrix(c) * Vec4d(1.0, 0.5, 0.0, 1.0);
         checkVec(view, Vec4d(1.0, 0.5, -5.0, 1.0), 1e-12);
         CHECK(view.w == doctest::Approx(1.0));
@@ -135,8 +125,8 @@ TEST_SUITE("exercise 6.1") {
         CHECK(far.z / far.w == doctest::Approx(1.0));
     }
     TEST_CASE("pixel centres land where the ray tracer's primary rays go") {
-        Camera c =
-            makeCamera(Vec3(0.3f, 1.2f, 4.0f), Vec3(-0.2f, 0.1f, 0.0f), Vec3(0, 1, 0), 50.0f, 1.5f);
+        Camera c = Camera::lookingAt(Vec3(0.3f, 1.2f, 4.0f), Vec3(-0.2f, 0.1f, 0.0f), Vec3(0, 1, 0),
+                                     50.0f, 1.5f);
         const int w = 90, h = 60;
         Mat4d m = projectionMatrix(c, 0.01, 100.0) * viewMatrix(c);
         for (auto [x, y] : {std::pair{0, 0}, {89, 59}, {45, 30}, {3, 57}}) {
@@ -150,7 +140,7 @@ TEST_SUITE("exercise 6.1") {
         }
     }
     TEST_CASE("hard case: view parallel to up gives a finite view matrix") {
-        Camera c = makeCamera(Vec3(0, 5, 0), Vec3(0, 0, 0), Vec3(0, 1, 0), 60.0f, 1.0f);
+        Camera c = Camera::lookingAt(Vec3(0, 5, 0), Vec3(0, 0, 0), Vec3(0, 1, 0), 60.0f, 1.0f);
         Mat4d v = viewMatrix(c);
         for (int i = 0; i < 4; ++i)
             for (int j = 0; j < 4; ++j) CHECK(std::isfinite(v[i][j]));
@@ -398,10 +388,11 @@ TEST_SUITE("raster vs ray tracer") {
     TEST_CASE("generated scenes from several views agree on at least 99.5 percent") {
         Scene s = generatedScene(7);
         for (const Camera& c :
-             {makeCamera(Vec3(0, 2.5f, 4), Vec3(0, 0, 0), Vec3(0, 1, 0), 50.0f, 4.0f / 3.0f),
-              makeCamera(Vec3(-3, 0.7f, 0.2f), Vec3(2, 0.2f, 0), Vec3(0, 1, 0), 70.0f, 4.0f / 3.0f),
-              makeCamera(Vec3(0.1f, 0.4f, 0.1f), Vec3(1, 0.3f, 1), Vec3(0, 1, 0), 90.0f,
-                         4.0f / 3.0f)}) {
+             {Camera::lookingAt(Vec3(0, 2.5f, 4), Vec3(0, 0, 0), Vec3(0, 1, 0), 50.0f, 4.0f / 3.0f),
+              Camera::lookingAt(Vec3(-3, 0.7f, 0.2f), Vec3(2, 0.2f, 0), Vec3(0, 1, 0), 70.0f,
+                                4.0f / 3.0f),
+              Camera::lookingAt(Vec3(0.1f, 0.4f, 0.1f), Vec3(1, 0.3f, 1), Vec3(0, 1, 0), 90.0f,
+                                4.0f / 3.0f)}) {
             Agreement a = agreementOf(s, c, 160, 120);
             CHECK(a.visibility.coveredEither > 1000);
             checkAgreement(a, 0.995);
@@ -423,8 +414,8 @@ TEST_SUITE("raster vs ray tracer") {
         }
         Scene s = makeScene(shared + "/oa_thor.obj", {test::dataDir(), 4.0f / 3.0f});
         attachGrid(s);
-        Camera c =
-            makeCamera(Vec3(960, -384, 2), Vec3(960, 600, 2), Vec3(0, 0, 1), 90.0f, 4.0f / 3.0f);
+        Camera c = Camera::lookingAt(Vec3(960, -384, 2), Vec3(960, 600, 2), Vec3(0, 0, 1), 90.0f,
+                                     4.0f / 3.0f);
         Agreement a = agreementOf(s, c, 200, 150);
         checkAgreement(a, 0.995);
         // Most of the map lies behind the eye or crosses the near plane.
@@ -454,7 +445,7 @@ TEST_SUITE("raster vs ray tracer") {
 TEST_SUITE("hard cases 06") {
     TEST_CASE("hard case: view direction parallel to up still renders and agrees") {
         Scene s = generatedScene(2);
-        Camera c = makeCamera(Vec3(0, 5, 0), Vec3(0, 0, 0), Vec3(0, 1, 0), 60.0f, 1.0f);
+        Camera c = Camera::lookingAt(Vec3(0, 5, 0), Vec3(0, 0, 0), Vec3(0, 1, 0), 60.0f, 1.0f);
         Agreement a = agreementOf(s, c, 80, 80);
         CHECK(a.visibility.coveredEither > 1000);
         // Seen straight from above, the terrain's grid lines run through pixel centres:
@@ -471,7 +462,7 @@ TEST_SUITE("hard cases 06") {
         s.mesh.triangles = {{0, 1, 2}};
         s.mesh.computeVertexNormals();
         attachGrid(s);
-        Camera c = makeCamera(Vec3(0, 0, 0), Vec3(0, -0.3f, -1), Vec3(0, 1, 0), 80.0f, 1.0f);
+        Camera c = Camera::lookingAt(Vec3(0, 0, 0), Vec3(0, -0.3f, -1), Vec3(0, 1, 0), 80.0f, 1.0f);
         Agreement a = agreementOf(s, c, 64, 64);
         CHECK(a.stats.clipped == 1);
         CHECK(a.visibility.coveredRaster > 1000);
@@ -512,7 +503,7 @@ TEST_SUITE("hard cases 06") {
         RasterSettings rs;
         rs.width = rs.height = 32;
         FrameBuffers b;
-        Camera c = makeCamera(Vec3(0, 0, 3), Vec3(0, 0, 0), Vec3(0, 1, 0), 60.0f, 1.0f);
+        Camera c = Camera::lookingAt(Vec3(0, 0, 3), Vec3(0, 0, 0), Vec3(0, 1, 0), 60.0f, 1.0f);
         FrameStats stats = rasterizeFrame(raster, c, rs, b);
         CHECK(stats.pixelsCovered > 50);
         for (uint32_t id : b.triangle) CHECK((id == kNoPrimitive || id == 0));
@@ -527,7 +518,7 @@ TEST_SUITE("hard cases 06") {
     TEST_CASE("hard case: near and far are checked") {
         Scene s = generatedScene(1);
         RasterScene raster = RasterScene::fromScene(s);
-        Camera c = makeCamera(Vec3(0, 2, 4), Vec3(0, 0, 0), Vec3(0, 1, 0), 60.0f, 1.0f);
+        Camera c = Camera::lookingAt(Vec3(0, 2, 4), Vec3(0, 0, 0), Vec3(0, 1, 0), 60.0f, 1.0f);
         RasterSettings rs;
         rs.near = -1.0;
         CHECK_THROWS_AS(nearFarFor(raster, c, rs), InputError);
@@ -542,42 +533,46 @@ TEST_SUITE("hard cases 06") {
 }
 
 TEST_SUITE("shadows 06") {
-    TEST_CASE("the hybrid's shadow rays match the ray tracer's shadows") {
+    // The bunny scene rasterized and ray traced (with shadow rays) at 160x120: the shadows
+    // shaded into the raster frame are compared with the ray tracer's.
+    struct BunnyFrames {
         Scene s = makeScene("bunny", {test::dataDir(), 4.0f / 3.0f});
-        attachGrid(s);
-        RasterScene raster = RasterScene::fromScene(s);
-        RasterSettings rs;
-        rs.width = 160;
-        rs.height = 120;
+        RasterScene raster;
         FrameBuffers b;
-        rasterizeFrame(raster, s.camera, rs, b);
-        TracedFrame traced = traceFrame(s, s.camera, rs.width, rs.height, true, 0);
+        TracedFrame traced;
+        BunnyFrames() {
+            attachGrid(s);
+            raster = RasterScene::fromScene(s);
+            RasterSettings rs;
+            rs.width = 160;
+            rs.height = 120;
+            rasterizeFrame(raster, s.camera, rs, b);
+            traced = traceFrame(s, s.camera, rs.width, rs.height, true, 0);
+        }
+        ShadowComparison compare(const ShadeSettings& ss,
+                                 const std::vector<ShadowMap>* maps = nullptr) const {
+            ShadedFrame f = shadeFrame(s, raster, s.camera, b, ss, maps);
+            return compareShadows(meshIds(raster, b), f.litByFirstLight, traced.ids,
+                                  traced.litByFirstLight);
+        }
+    };
+
+    TEST_CASE("the hybrid's shadow rays match the ray tracer's shadows") {
+        BunnyFrames frames;
         ShadeSettings ss;
         ss.shadows = ShadowMode::Rays;
-        ShadedFrame f = shadeFrame(s, raster, s.camera, b, ss);
-        ShadowComparison c = compareShadows(meshIds(raster, b), f.litByFirstLight, traced.ids,
-                                            traced.litByFirstLight);
+        ShadowComparison c = frames.compare(ss);
         CHECK(c.compared > 2500);
         CHECK(c.disagreement() < 0.002);
     }
     TEST_CASE("the shadow map: acne without bias and peter-panning with too much") {
-        Scene s = makeScene("bunny", {test::dataDir(), 4.0f / 3.0f});
-        attachGrid(s);
-        RasterScene raster = RasterScene::fromScene(s);
-        RasterSettings rs;
-        rs.width = 160;
-        rs.height = 120;
-        FrameBuffers b;
-        rasterizeFrame(raster, s.camera, rs, b);
-        TracedFrame traced = traceFrame(s, s.camera, rs.width, rs.height, true, 0);
-        std::vector<ShadowMap> maps{buildShadowMap(raster, s.lights[0], 1024)};
+        BunnyFrames frames;
+        std::vector<ShadowMap> maps{buildShadowMap(frames.raster, frames.s.lights[0], 1024)};
         auto compareAt = [&](double relativeBias) {
             ShadeSettings ss;
             ss.shadows = ShadowMode::Map;
-            ss.mapBias = relativeBias * double(raster.diagonal());
-            ShadedFrame f = shadeFrame(s, raster, s.camera, b, ss, &maps);
-            return compareShadows(meshIds(raster, b), f.litByFirstLight, traced.ids,
-                                  traced.litByFirstLight);
+            ss.mapBias = relativeBias * double(frames.raster.diagonal());
+            return frames.compare(ss, &maps);
         };
         ShadowComparison none = compareAt(1e-12), good = compareAt(2e-3), large = compareAt(5e-2);
         INFO("acne " << none.acne << " / " << good.acne << " / " << large.acne << ", leaks "
@@ -616,13 +611,14 @@ TEST_SUITE("frustum culling 06") {
     }
     TEST_CASE("the culled render is identical to the unculled one: bunny close-up") {
         Scene s = makeScene("bunny", {test::dataDir(), 4.0f / 3.0f});
-        checkCulledIdentical(s, makeCamera(Vec3(-0.35f, 0.55f, 0.9f), Vec3(-0.45f, 0.5f, 0.0f),
-                                           Vec3(0, 1, 0), 40.0f, 4.0f / 3.0f));
+        checkCulledIdentical(
+            s, Camera::lookingAt(Vec3(-0.35f, 0.55f, 0.9f), Vec3(-0.45f, 0.5f, 0.0f), Vec3(0, 1, 0),
+                                 40.0f, 4.0f / 3.0f));
     }
     TEST_CASE("the culled render is identical to the unculled one: inside a generated scene") {
         Scene s = generatedScene(5);
-        checkCulledIdentical(s, makeCamera(Vec3(0.0f, 0.5f, 0.0f), Vec3(1.0f, 0.3f, 0.2f),
-                                           Vec3(0, 1, 0), 60.0f, 4.0f / 3.0f));
+        checkCulledIdentical(s, Camera::lookingAt(Vec3(0.0f, 0.5f, 0.0f), Vec3(1.0f, 0.3f, 0.2f),
+                                                  Vec3(0, 1, 0), 60.0f, 4.0f / 3.0f));
     }
 }
 
@@ -631,14 +627,8 @@ TEST_SUITE("program 06") {
 
     TEST_CASE("headless render writes a PNG and the ids and depth buffers") {
         test::TempDir dir;
-        auto run = test::runProgram(
-            program,
-            "--headless --scene sh1 --width 64 --height 40 --out a.png --ids a.ids "
-            "--depth a.depth --json",
-            dir);
-        INFO(run.err);
-        REQUIRE(run.exitCode == 0);
-        CHECK(test::pngSize(dir.file("a.png")) == std::pair{64, 40});
+        auto run = test::runHeadless(program, dir, 64, 40,
+                                     "--scene sh1 --ids a.ids --depth a.depth --json");
         std::string ids = test::readText(dir.file("a.ids")),
                     depth = test::readText(dir.file("a.depth"));
         REQUIRE(ids.size() == 64 * 40 * 4);
@@ -663,69 +653,38 @@ TEST_SUITE("program 06") {
     }
     TEST_CASE("compare mode prints the agreement and writes the difference image") {
         test::TempDir dir;
-        auto run = test::runProgram(
-            program, "--headless --scene sh1 --width 64 --height 48 --out a.png --compare", dir);
-        INFO(run.err);
-        REQUIRE(run.exitCode == 0);
+        auto run = test::runHeadless(program, dir, 64, 48, "--scene sh1 --compare");
         CHECK(run.out.find("same triangle:") != std::string::npos);
         CHECK(test::pngSize(dir.file("a-diff.png")) == std::pair{64, 48});
     }
     TEST_CASE("measurements: the JSON report has the step's tables") {
         test::TempDir dir;
-        auto run = test::runProgram(
-            program, "--headless --width 48 --height 36 --out a.png --measure --report r.json",
-            dir);
-        INFO(run.err);
-        REQUIRE(run.exitCode == 0);
-        std::string json = test::readText(dir.file("r.json"));
-        for (const char* id : {"\"visibility\"", "\"frame_time\"", "\"shadow_bias\"", "\"shadows\"",
-                               "\"interpolation\"", "\"culling\""})
-            CHECK(json.find(id) != std::string::npos);
+        test::runHeadless(program, dir, 48, 36, "--measure --report r.json");
+        test::checkReportTables(dir.file("r.json"), {"visibility", "frame_time", "shadow_bias",
+                                                     "shadows", "interpolation", "culling"});
         CHECK(test::pngSize(dir.file("a-affine.png")) == std::pair{48, 36});
     }
     TEST_CASE("window: scripted frames with key presses under the offscreen video driver") {
         test::TempDir dir;
-        auto run = test::runProgram(
-            program,
-            "--scene sh1 --width 64 --height 48 --frames 8 --keys r,d,h,b,p,f,Left "
-            "--screenshot shot.png",
-            dir, test::kWindowEnvironment);
-        INFO(run.err);
-        REQUIRE(run.exitCode == 0);
-        CHECK(test::pngSize(dir.file("shot.png")).first > 0);
+        test::runWindowScript(program, dir, "--scene sh1 --width 64 --height 48", 8,
+                              "r,d,h,b,p,f,Left");
     }
     TEST_CASE("bad input: one clear line and a non-zero exit") {
         test::TempDir dir;
         std::ofstream(dir.file("nan.obj")) << "v 0 0 0\nv 1 nan 0\nv 0 1 0\nf 1 2 3\n";
-        struct Case {
-            std::string args, expect;
-            int code;
-        };
-        for (const Case& c : std::vector<Case>{
-                 {"--scene sh1 --eye 1,2,3 --look 1,2,3", "view direction is zero", 1},
-                 {"--scene sh1 --near 0", "--near", 1},
-                 {"--scene sh1 --near -2", "--near", 1},
-                 {"--scene sh1 --near 2 --far 1", "--far", 1},
-                 {"--scene sh1 --width 0", "width", 2},
-                 {"--scene sh1 --height 0", "height", 2},
-                 {"--scene nan.obj", "non-finite", 1},
-                 {"--scene sh1 --shadows sometimes", "shadows", 2}}) {
-            INFO(c.args);
-            auto run = test::runProgram(program, "--headless --out bad.png " + c.args, dir);
-            CHECK(run.exitCode == c.code);
-            CHECK(test::lineCount(run.err) == 1);
-            CHECK(run.err.find(c.expect) != std::string::npos);
-            CHECK_FALSE(std::filesystem::exists(dir.file("bad.png")));
-        }
+        test::checkBadInput(program, dir,
+                            {{"--scene sh1 --eye 1,2,3 --look 1,2,3", "view direction is zero", 1},
+                             {"--scene sh1 --near 0", "--near", 1},
+                             {"--scene sh1 --near -2", "--near", 1},
+                             {"--scene sh1 --near 2 --far 1", "--far", 1},
+                             {"--scene sh1 --width 0", "width", 2},
+                             {"--scene sh1 --height 0", "height", 2},
+                             {"--scene nan.obj", "non-finite", 1},
+                             {"--scene sh1 --shadows sometimes", "shadows", 2}});
     }
     TEST_CASE("a view parallel to up renders") {
         test::TempDir dir;
-        auto run = test::runProgram(program,
-                                    "--headless --scene sh1 --width 32 --height 24 --out a.png "
-                                    "--eye 176,100,-112 --look 176,0,-112 --up 0,1,0",
-                                    dir);
-        INFO(run.err);
-        REQUIRE(run.exitCode == 0);
-        CHECK(test::pngSize(dir.file("a.png")) == std::pair{32, 24});
+        test::runHeadless(program, dir, 32, 24,
+                          "--scene sh1 --eye 176,100,-112 --look 176,0,-112 --up 0,1,0");
     }
 }

@@ -9,6 +9,7 @@
 #include <fstream>
 #include <sstream>
 #include <string>
+#include <vector>
 
 #include "core/math.hpp"
 #include "core/render.hpp"
@@ -80,6 +81,65 @@ inline std::pair<int, int> pngSize(const std::string& path) {
                    (uint8_t(bytes[i + 2]) << 8) | uint8_t(bytes[i + 3]));
     };
     return {be32(16), be32(20)};
+}
+
+// ---- The "program NN" suites: the checks every step program's runs share ---------------
+
+// `program --headless --width W --height H --out a.png args` in dir: exits 0 and writes
+// a.png of W x H (its stderr shown when not).
+inline ProgramRun runHeadless(const std::string& program, const TempDir& dir, int width, int height,
+                              const std::string& args = "") {
+    auto run = runProgram(program,
+                          "--headless --width " + std::to_string(width) + " --height " +
+                              std::to_string(height) + " --out a.png " + args,
+                          dir);
+    INFO(run.err);
+    REQUIRE(run.exitCode == 0);
+    CHECK(pngSize(dir.file("a.png")) == std::pair{width, height});
+    return run;
+}
+
+// The JSON report at `path` has every table id ("triangle_speed": the quoted key).
+inline void checkReportTables(const std::string& path, std::initializer_list<const char*> ids) {
+    std::string json = readText(path);
+    for (const char* id : ids) {
+        INFO(id);
+        CHECK(json.find(std::string("\"") + id + "\"") != std::string::npos);
+    }
+}
+
+// `program args --frames N --keys K --screenshot shot.png` under the offscreen video
+// driver: exits 0 and saves a non-empty screenshot of the last frame.
+inline ProgramRun runWindowScript(const std::string& program, const TempDir& dir,
+                                  const std::string& args, int frames, const std::string& keys) {
+    auto run = runProgram(
+        program,
+        args + " --frames " + std::to_string(frames) + " --keys " + keys + " --screenshot shot.png",
+        dir, kWindowEnvironment);
+    INFO(run.err);
+    REQUIRE(run.exitCode == 0);
+    CHECK(pngSize(dir.file("shot.png")).first > 0);
+    return run;
+}
+
+// Bad input: `program prefix args` exits with `code`, writes one line on stderr that
+// contains `expect`, and leaves none of `outputs` behind in dir.
+struct BadInput {
+    std::string args, expect;
+    int code;
+};
+inline void checkBadInput(const std::string& program, const TempDir& dir,
+                          const std::vector<BadInput>& cases,
+                          const std::string& prefix = "--headless --out bad.png ",
+                          std::initializer_list<const char*> outputs = {"bad.png"}) {
+    for (const BadInput& c : cases) {
+        INFO(c.args);
+        auto run = runProgram(program, prefix + c.args, dir);
+        CHECK(run.exitCode == c.code);
+        CHECK(lineCount(run.err) == 1);
+        CHECK(run.err.find(c.expect) != std::string::npos);
+        for (const char* output : outputs) CHECK_FALSE(std::filesystem::exists(dir.file(output)));
+    }
 }
 
 // Every component within an absolute tolerance.

@@ -2,11 +2,14 @@
 """Step 04 beside Intel Embree: the same rays, back to back, one thread each.
 
 usage: tools/bench04.py [--rays N] [--repeat K] [--meshes bunny,motorbike,oa_thor]
+                        [--kinds primary,diffuse,random] [--builders midpoint,median,sah,sah4]
+                        [--no-extras]
                         [--out out/04_bvh_bench.json] [--data DIR] [--program PATH]
 
 For every mesh and ray kind (primary, diffuse, random) it writes one ray set with
 peer-bench's make_rays.py, runs peer-bench (Embree 3, one thread) and then our
-`04_bvh trace` with each builder on that file, each --repeat times (the programs report
+`04_bvh trace` with each builder on that file (and "sah 4-wide": the binned SAH tree
+collapsed to 4-wide nodes, `--width 4`), each --repeat times (the programs report
 the median), and compares the hits ray by ray with Embree's. The interior map (oa_thor)
 gets its primary rays from the inside camera of the meshes README. Also: binned SAH on
 2 threads against 1, and the full-sweep SAH cost (the quality reference). Prints the
@@ -78,6 +81,11 @@ def main():
     ap.add_argument("--rays", type=int, default=250000)
     ap.add_argument("--repeat", type=int, default=5)
     ap.add_argument("--meshes", default="bunny,motorbike,oa_thor")
+    ap.add_argument("--kinds", default="primary,diffuse,random")
+    ap.add_argument("--builders", default="midpoint,median,sah,sah4",
+                    help="sah4: the binned SAH tree collapsed to 4-wide nodes (SIMD)")
+    ap.add_argument("--no-extras", action="store_true",
+                    help="skip the two-thread runs and the sweep-SAH quality reference")
     ap.add_argument("--data", default="/work/shared/data/meshes")
     ap.add_argument("--out", default=os.path.join(ROOT, "out", "04_bvh_bench.json"))
     ap.add_argument("--program", default=os.path.join(ROOT, "build/release/steps/04_bvh/04_bvh"))
@@ -94,7 +102,7 @@ def main():
     for mesh in a.meshes.split(","):
         obj = os.path.join(a.data, mesh + ".obj")
         sweep = None
-        for kind in ("primary", "diffuse", "random"):
+        for kind in a.kinds.split(","):
             rays = os.path.join(work, "%s-%s.bin" % (mesh, kind))
             extra = INSIDE if (mesh == "oa_thor" and kind == "primary") else []
             subprocess.run(["/usr/bin/python3", os.path.join(peer_src, "make_rays.py"), obj, kind,
@@ -102,10 +110,16 @@ def main():
             ehits = os.path.join(work, "embree.bin")
             emb = run_embree([peer, obj, rays, ehits, "--threads", "1"], a.repeat)
             eh = read_hits(ehits)
-            for builder in ("midpoint", "median", "sah"):
+            # "sah 4-wide": the binned SAH tree collapsed to 4-wide nodes, SIMD traversal.
+            for builder, args in (("midpoint", ["--builder", "midpoint"]),
+                                  ("median", ["--builder", "median"]),
+                                  ("sah", ["--builder", "sah"]),
+                                  ("sah 4-wide", ["--builder", "sah", "--width", "4"])):
+                if (builder.replace(" 4-wide", "4")) not in a.builders.split(","):
+                    continue
                 ohits = os.path.join(work, "ours.bin")
                 ours = run_ours([a.program, "trace", "--mesh", obj, "--rays", rays, "--hits",
-                                  ohits, "--builder", builder, "--threads", "1"], a.repeat)
+                                  ohits, "--threads", "1"] + args, a.repeat)
                 row = {"mesh": mesh, "kind": kind, "builder": builder,
                        "mrays_per_s": ours["mrays_per_s"], "embree_mrays_per_s": emb["mrays_per_s"],
                        "ratio": ours["mrays_per_s"] / emb["mrays_per_s"],
@@ -117,12 +131,12 @@ def main():
                        "sah_cost": ours["sah_cost"], "tris": ours["tris"], "rays": ours["rays"],
                        "agree_with_embree": agreement(read_hits(ohits), eh)}
                 rows.append(row)
-                print("%-9s %-8s %-8s %7.3f Mrays/s  x%.2f Embree (CPU time: x%.2f)  build %8.1f ms"
+                print("%-9s %-8s %-10s %7.3f Mrays/s  x%.2f Embree (CPU time: x%.2f)  build %8.1f ms"
                       "  SAH %.2f  agree %.4f" % (mesh, kind, builder, row["mrays_per_s"],
                                                   row["ratio"], row["cpu_ratio"], row["build_ms"],
                                                   row["sah_cost"], row["agree_with_embree"]),
                       file=sys.stderr)
-            if kind in ("primary", "diffuse"):
+            if kind in ("primary", "diffuse") and not a.no_extras:
                 one = run_json([a.program, "trace", "--mesh", obj, "--rays", rays, "--hits", ohits,
                                 "--threads", "1", "--repeat", str(a.repeat)])
                 two = run_json([a.program, "trace", "--mesh", obj, "--rays", rays, "--hits", ohits,
@@ -130,10 +144,13 @@ def main():
                 threads.append({"mesh": mesh, "kind": kind, "one": one["mrays_per_s"],
                                 "two": two["mrays_per_s"],
                                 "speedup": two["mrays_per_s"] / one["mrays_per_s"]})
-            if sweep is None:
+            if sweep is None and not a.no_extras:
                 sweep = run_json([a.program, "trace", "--mesh", obj, "--rays", rays, "--hits", ohits,
                                   "--builder", "sweep-sah"])
-                sah = [r for r in rows if r["mesh"] == mesh and r["builder"] == "sah"][0]
+                sah = [r for r in rows if r["mesh"] == mesh and r["builder"] == "sah"]
+                if not sah:
+                    continue
+                sah = sah[0]
                 quality.append({"mesh": mesh, "tris": sah["tris"], "sah_cost": sah["sah_cost"],
                                 "sweep_sah_cost": sweep["sah_cost"],
                                 "excess_pct": 100.0 * (sah["sah_cost"] / sweep["sah_cost"] - 1.0),
@@ -143,18 +160,29 @@ def main():
 
     print("\nStep 04 beside Embree 3 (one thread each, medians of %d runs, %d rays per set)"
           % (a.repeat, a.rays))
-    print("%-10s %-8s %-9s %9s %9s %7s %9s %10s %9s %8s" % ("mesh", "rays", "builder", "Mrays/s",
+    print("%-10s %-8s %-10s %9s %9s %7s %9s %10s %9s %8s" % ("mesh", "rays", "builder", "Mrays/s",
           "Embree", "ratio", "CPU ratio", "build ms", "SAH cost", "agree"))
     for r in rows:
-        print("%-10s %-8s %-9s %9.3f %9.3f %7.3f %9.3f %10.1f %9.2f %8.4f" % (
+        print("%-10s %-8s %-10s %9.3f %9.3f %7.3f %9.3f %10.1f %9.2f %8.4f" % (
             r["mesh"], r["kind"], r["builder"], r["mrays_per_s"], r["embree_mrays_per_s"],
             r["ratio"], r["cpu_ratio"], r["build_ms"], r["sah_cost"], r["agree_with_embree"]))
     print("\nBinned SAH against midpoint (primary rays; wall, CPU time):")
     for mesh in a.meshes.split(","):
         by = {r["builder"]: r for r in rows if r["mesh"] == mesh and r["kind"] == "primary"}
+        if "sah" not in by or "midpoint" not in by:
+            continue
         print("  %-10s %.2fx  %.2fx" % (
             mesh, by["sah"]["mrays_per_s"] / by["midpoint"]["mrays_per_s"],
             by["sah"]["cpu_mrays_per_s"] / by["midpoint"]["cpu_mrays_per_s"]))
+    print("\n4-wide (SIMD) against the binary tree, binned SAH (wall, CPU time):")
+    for mesh in a.meshes.split(","):
+        for kind in a.kinds.split(","):
+            by = {r["builder"]: r for r in rows if r["mesh"] == mesh and r["kind"] == kind}
+            if "sah" not in by or "sah 4-wide" not in by:
+                continue
+            print("  %-10s %-8s %.2fx  %.2fx" % (
+                mesh, kind, by["sah 4-wide"]["mrays_per_s"] / by["sah"]["mrays_per_s"],
+                by["sah 4-wide"]["cpu_mrays_per_s"] / by["sah"]["cpu_mrays_per_s"]))
     print("\nBuild and quality (binned SAH, 16 bins, one thread):")
     for q in quality:
         print("  %-10s %8d tris  %7.1f ms  %.3f s/Mtri (CPU %.3f)  SAH %.2f vs sweep %.2f "

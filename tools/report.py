@@ -95,7 +95,9 @@ def main():
             reports.append(json.load(f))
     results = suite_results(out)
     parts = []
-    machine = reports[0]["machine"] if reports else "unknown machine"
+    # Every step report names its machine; reports copied together from two machines say so.
+    machines = sorted({r.get("machine", "an unknown machine") for r in reports})
+    machine = " and ".join(machines) if machines else "an unknown machine"
     # Exercise status.
     rows = []
     total = earned = 0

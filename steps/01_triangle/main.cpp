@@ -69,12 +69,6 @@ Table accuracyVersusTime(const Table& speed, const Table& cracks) {
     return t;
 }
 
-std::string withSuffix(const std::string& png, const std::string& suffix) {
-    std::string stem =
-        png.size() > 4 && png.ends_with(".png") ? png.substr(0, png.size() - 4) : png;
-    return stem + suffix + ".png";
-}
-
 }  // namespace
 
 int main(int argc, char** argv) {
@@ -102,32 +96,20 @@ int main(int argc, char** argv) {
                 std::make_shared<TriangleGrid>(scene.mesh, scene.meshMaterial, parseTest(testName));
             scene.geometries.push_back(grid);
         }
-        RenderSettings settings;
-        settings.width = opts.width;
-        settings.height = opts.height;
-        settings.threads = opts.threads;
-        settings.seed = opts.seed;
+        RenderSettings settings = opts.renderSettings();
 
         if (opts.headless) {
             Report report;
             report.program = "01_triangle";
-            std::string out = opts.out.empty() ? "01_triangle.png" : opts.out;
-            settings.progressLabel = "01_triangle: rendering";
-            Stopwatch watch;
-            RayCounts counts;
-            Image image = renderImage(scene, scene.camera, settings, &counts);
-            double renderSeconds = watch.seconds();
-            image.writePng(out);
-            report.images.push_back({out, std::string("scene '") + scene.name + "' with the " +
-                                              triangleTestName(parseTest(testName)) + " test"});
-            report.facts["render_ms"] = renderSeconds * 1e3;
-            report.facts["rays"] = counts.total();
-            std::cerr << "01_triangle: wrote " << out << " (" << image.width() << "x"
-                      << image.height() << ", " << formatSeconds(renderSeconds) << ")\n";
+            std::string out = headlessPath(opts, report.program);
+            Image image = renderHeadlessImage(scene, scene.camera, settings, out,
+                                              "scene '" + scene.name + "' with the " +
+                                                  triangleTestName(parseTest(testName)) + " test",
+                                              report);
             if (measure && grid) {
                 Image marked = image;
                 size_t differ = markDisagreements(*grid, scene.camera, marked, opts.threads);
-                std::string disagreePath = withSuffix(out, "-disagree");
+                std::string disagreePath = pngWithSuffix(out, "-disagree");
                 marked.writePng(disagreePath);
                 report.images.push_back(
                     {disagreePath,
@@ -155,8 +137,7 @@ int main(int argc, char** argv) {
                                          "Accuracy against time: cracks per million rays "
                                          "aimed at shared edges and vertices"}});
             }
-            report.write(opts.json ? std::cerr : std::cout, opts.json ? "-" : opts.reportPath);
-            if (opts.json && !opts.reportPath.empty()) report.write(std::cerr, opts.reportPath);
+            writeReport(report, opts);
             return 0;
         }
 
@@ -170,7 +151,6 @@ int main(int argc, char** argv) {
         WindowCallbacks cb;
         cb.keys = {{SDLK_t, "next triangle test (plane / Moller-Trumbore / watertight)"},
                    {SDLK_m, "mark pixels where the tests disagree (magenta)"}};
-        for (const KeyBinding& k : OrbitController::keys()) cb.keys.push_back(k);
         cb.onKey = [&](int key) {
             if (key == SDLK_t) {
                 test = TriangleTest((int(test) + 1) % 3);
@@ -182,13 +162,9 @@ int main(int argc, char** argv) {
                 dirty = true;
                 return true;
             }
-            if (orbit.onKey(key)) return dirty = true;
             return false;
         };
-        cb.onMouseDrag = [&](float dx, float dy) {
-            orbit.onDrag(dx, dy);
-            dirty = true;
-        };
+        orbit.addTo(cb, [&] { dirty = true; });
         cb.frame = [&](double) -> const Image& {
             if (dirty) {
                 if (grid) grid->setTest(test);

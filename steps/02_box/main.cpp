@@ -53,12 +53,6 @@ PixelComparison markDisagreements(const BoxSet& set, const Camera& camera, Image
     return c;
 }
 
-std::string withSuffix(const std::string& png, const std::string& suffix) {
-    std::string stem =
-        png.size() > 4 && png.ends_with(".png") ? png.substr(0, png.size() - 4) : png;
-    return stem + suffix + ".png";
-}
-
 }  // namespace
 
 int main(int argc, char** argv) {
@@ -94,36 +88,24 @@ int main(int argc, char** argv) {
         BoxMethod method = methodName == "planes" ? BoxMethod::SixPlanes : BoxMethod::Slabs;
         auto set = std::make_shared<BoxSet>(boxList, method);
         scene.geometries.push_back(set);
-        RenderSettings settings;
-        settings.width = opts.width;
-        settings.height = opts.height;
-        settings.threads = opts.threads;
-        settings.seed = opts.seed;
+        RenderSettings settings = opts.renderSettings();
 
         if (opts.headless) {
             Report report;
             report.program = "02_box";
-            std::string out = opts.out.empty() ? "02_box.png" : opts.out;
-            settings.progressLabel = "02_box: rendering";
-            Stopwatch watch;
-            RayCounts counts;
-            Image image = renderImage(scene, scene.camera, settings, &counts);
-            double renderSeconds = watch.seconds();
-            image.writePng(out);
-            report.images.push_back({out, "scene '" + scene.name + "' (" +
-                                              std::to_string(boxList.size()) + " boxes) with the " +
-                                              boxMethodName(method) + " method"});
-            report.facts["render_ms"] = renderSeconds * 1e3;
-            report.facts["rays"] = counts.total();
-            std::cerr << "02_box: wrote " << out << " (" << image.width() << "x" << image.height()
-                      << ", " << formatSeconds(renderSeconds) << ")\n";
+            std::string out = headlessPath(opts, report.program);
+            Image image = renderHeadlessImage(
+                scene, scene.camera, settings, out,
+                "scene '" + scene.name + "' (" + std::to_string(boxList.size()) +
+                    " boxes) with the " + boxMethodName(method) + " method",
+                report);
             if (measure) {
                 set->setMethod(BoxMethod::SixPlanes);  // both methods' data ready
                 set->setMethod(method);
                 Image marked = image;
                 PixelComparison pixels =
                     markDisagreements(*set, scene.camera, marked, opts.threads);
-                std::string disagreePath = withSuffix(out, "-disagree");
+                std::string disagreePath = pngWithSuffix(out, "-disagree");
                 marked.writePng(disagreePath);
                 report.images.push_back(
                     {disagreePath,
@@ -162,8 +144,7 @@ int main(int argc, char** argv) {
                      {"logy", true},
                      {"title", "Six planes against slabs: time per test and the error of t"}});
             }
-            report.write(opts.json ? std::cerr : std::cout, opts.json ? "-" : opts.reportPath);
-            if (opts.json && !opts.reportPath.empty()) report.write(std::cerr, opts.reportPath);
+            writeReport(report, opts);
             return 0;
         }
 
@@ -175,7 +156,6 @@ int main(int argc, char** argv) {
         WindowCallbacks cb;
         cb.keys = {{SDLK_m, "switch method: six planes / slabs"},
                    {SDLK_d, "mark pixels where the two methods disagree (magenta)"}};
-        for (const KeyBinding& k : OrbitController::keys()) cb.keys.push_back(k);
         cb.onKey = [&](int key) {
             if (key == SDLK_m) {
                 method = method == BoxMethod::Slabs ? BoxMethod::SixPlanes : BoxMethod::Slabs;
@@ -186,13 +166,9 @@ int main(int argc, char** argv) {
                 if (marks) set->setMethod(BoxMethod::SixPlanes);
                 return dirty = true;
             }
-            if (orbit.onKey(key)) return dirty = true;
             return false;
         };
-        cb.onMouseDrag = [&](float dx, float dy) {
-            orbit.onDrag(dx, dy);
-            dirty = true;
-        };
+        orbit.addTo(cb, [&] { dirty = true; });
         cb.frame = [&](double) -> const Image& {
             if (dirty) {
                 set->setMethod(method);

@@ -59,32 +59,19 @@ int main(int argc, char** argv) {
         Scene& scene = objects.scene;
         bool pretest = pretestName == "on";
         objects.setPretest(pretest);
-        RenderSettings settings;
-        settings.width = opts.width;
-        settings.height = opts.height;
-        settings.threads = opts.threads;
-        settings.seed = opts.seed;
+        RenderSettings settings = opts.renderSettings();
 
         if (opts.headless) {
             Report report;
             report.program = "03_aabb";
-            std::string out = opts.out.empty() ? "03_aabb.png" : opts.out;
-            settings.progressLabel = "03_aabb: rendering";
-            Stopwatch watch;
             RayCounts counts;
             objects.counts->reset();
-            Image image = renderImage(scene, scene.camera, settings, &counts);
-            double renderSeconds = watch.seconds();
-            image.writePng(out);
-            report.images.push_back(
-                {out, "scene '" + scene.name + "', box pre-test " + pretestName});
-            report.facts["render_ms"] = renderSeconds * 1e3;
-            report.facts["rays"] = counts.total();
+            renderHeadlessImage(scene, scene.camera, settings, headlessPath(opts, report.program),
+                                "scene '" + scene.name + "', box pre-test " + pretestName, report,
+                                &counts);
             report.facts["primitive_tests_per_ray"] =
                 double(objects.counts->primitiveTests.load()) /
                 double(std::max<uint64_t>(1, counts.total()));
-            std::cerr << "03_aabb: wrote " << out << " (" << image.width() << "x" << image.height()
-                      << ", " << formatSeconds(renderSeconds) << ")\n";
             if (measure) {
                 std::cerr << "03_aabb: slab tests on hard rays...\n";
                 for (Table& t : measureSlabTests(makeHardSlabRays(hardRays, opts.seed), 15))
@@ -113,8 +100,7 @@ int main(int argc, char** argv) {
                      {"logy", true},
                      {"title", "A box pre-test: time per frame and primitive tests per ray"}});
             }
-            report.write(opts.json ? std::cerr : std::cout, opts.json ? "-" : opts.reportPath);
-            if (opts.json && !opts.reportPath.empty()) report.write(std::cerr, opts.reportPath);
+            writeReport(report, opts);
             return 0;
         }
 
@@ -126,19 +112,14 @@ int main(int argc, char** argv) {
         double renderMs = 0.0, testsPerRay = 0.0, boxesPerRay = 0.0;
         WindowCallbacks cb;
         cb.keys = {{SDLK_b, "bounding-box pre-test on / off (off: quarter resolution)"}};
-        for (const KeyBinding& k : OrbitController::keys()) cb.keys.push_back(k);
         cb.onKey = [&](int key) {
             if (key == SDLK_b) {
                 pretest = !pretest;
                 return dirty = true;
             }
-            if (orbit.onKey(key)) return dirty = true;
             return false;
         };
-        cb.onMouseDrag = [&](float dx, float dy) {
-            orbit.onDrag(dx, dy);
-            dirty = true;
-        };
+        orbit.addTo(cb, [&] { dirty = true; });
         cb.frame = [&](double) -> const Image& {
             if (dirty) {
                 objects.setPretest(pretest);

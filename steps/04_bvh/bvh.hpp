@@ -205,10 +205,14 @@ struct TraversalRay {
     static float inverse(float d) { return d == 0.0f ? kInfinity<float> : 1.0f / d; }
 
     static float marginFor(const Ray& ray, const Bvh& bvh) {
-        if (bvh.empty()) return 0.0f;
-        Bounds3f b = bvh.bounds();
-        float radius = 0.5f * glm::length(b.diagonal());
-        return 64.0f * 0x1p-24f * (glm::length(ray.origin - b.centroid()) + radius);
+        return bvh.empty() ? 0.0f : marginFor(ray, bvh.bounds());
+    }
+    // In double: in float the squared lengths overflow for coordinates beyond about 1e19,
+    // and an infinite margin turns every slab distance into NaN (every box entered).
+    static float marginFor(const Ray& ray, const Bounds3f& rootBounds) {
+        Vec3d lo(rootBounds.min), hi(rootBounds.max);
+        double radius = 0.5 * glm::length(hi - lo);
+        return float(64.0 * 0x1p-24 * (glm::length(Vec3d(ray.origin) - 0.5 * (lo + hi)) + radius));
     }
 };
 

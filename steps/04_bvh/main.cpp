@@ -9,6 +9,7 @@
 #include <iostream>
 #include <nlohmann/json.hpp>
 
+#include "04_bvh/bvh4.hpp"
 #include "04_bvh/measure.hpp"
 #include "core/app.hpp"
 #include "core/orbit.hpp"
@@ -29,7 +30,7 @@ double processCpuSeconds() {
 
 struct TraceOptions {
     std::string mesh, rays, hits, builder = "sah";
-    int threads = 1, repeat = 1, bins = 16;
+    int threads = 1, repeat = 1, bins = 16, width = 2;
 };
 
 // `trace`: build, trace every ray (median of --repeat), write HITS.bin, one JSON line.
@@ -42,13 +43,21 @@ int runTrace(const TraceOptions& o) {
     BvhBuildStats stats;
     double buildCpuStart = processCpuSeconds();
     Bvh bvh = buildBvh(mesh, build, &stats);
+    // --width 4: the binary tree collapsed to 4-wide nodes (bvh4.hpp); the collapse counts
+    // as build time.
+    Stopwatch collapseWatch;
+    Bvh4 wide = o.width == 4 ? collapseToBvh4(bvh) : Bvh4{};
+    if (o.width == 4) stats.buildMs += collapseWatch.seconds() * 1e3;
     double buildCpuSeconds = processCpuSeconds() - buildCpuStart;
     std::vector<TraceHit> hits;
     std::vector<double> seconds, cpuSeconds;
     for (int i = 0; i < o.repeat; ++i) {
         Stopwatch watch;
         double cpuStart = processCpuSeconds();
-        traceBatch(bvh, rays, hits, o.threads);
+        if (o.width == 4)
+            traceBatch(wide, rays, hits, o.threads);
+        else
+            traceBatch(bvh, rays, hits, o.threads);
         seconds.push_back(watch.seconds());
         cpuSeconds.push_back(processCpuSeconds() - cpuStart);
     }
@@ -66,6 +75,7 @@ int runTrace(const TraceOptions& o) {
                         {"hits", hitCount},
                         {"threads", o.threads},
                         {"builder", bvhBuilderName(build.builder)},
+                        {"width", o.width},
                         {"bins", o.bins},
                         {"repeat", o.repeat},
                         {"nodes", stats.nodes},
@@ -114,6 +124,13 @@ int runCheck(const CheckOptions& o) {
         }
         j[bvhBuilderName(builder)] = {{"differ", differ}, {"hits", hit}};
         total += differ;
+        if (builder == BvhBuilder::BinnedSah) {  // and its 4-wide collapse (bvh4.hpp)
+            traceBatch(collapseToBvh4(bvh), rays, hits, o.threads);
+            size_t differ4 = 0;
+            for (size_t i = 0; i < rays.size(); ++i) differ4 += !hitsAgree(hits[i], reference[i]);
+            j["sah-4wide"] = {{"differ", differ4}};
+            total += differ4;
+        }
     }
     if (o.cracks > 0) {
         Table t = measureBvhCracks({{o.mesh, &mesh}}, o.cracks, o.seed);
@@ -127,12 +144,6 @@ int runCheck(const CheckOptions& o) {
     j["ok"] = total == 0;
     std::cout << j.dump() << "\n";
     return total == 0 ? 0 : 1;
-}
-
-std::string withSuffix(const std::string& png, const std::string& suffix) {
-    std::string stem =
-        png.size() > 4 && png.ends_with(".png") ? png.substr(0, png.size() - 4) : png;
-    return stem + suffix + ".png";
 }
 
 const char* testName(CullTest test) {
@@ -184,6 +195,11 @@ int main(int argc, char** argv) {
         traceCommand->add_option("--repeat", trace.repeat, "trace runs; the median is reported")
             ->check(CLI::Range(1, 1000))
             ->capture_default_str();
+        traceCommand
+            ->add_option("--width", trace.width,
+                         "2: the binary tree; 4: its collapse to 4-wide nodes, SIMD traversal")
+            ->check(CLI::IsMember({2, 4}))
+            ->capture_default_str();
         traceCommand->add_option("--bins", trace.bins, "binned SAH: bins per axis")
             ->check(CLI::Range(2, 256))
             ->capture_default_str();
@@ -219,28 +235,16 @@ int main(int argc, char** argv) {
             scene.geometries.push_back(geometry);
         }
         Vec3 sceneUp = scene.camera.up;
-        RenderSettings settings;
-        settings.width = opts.width;
-        settings.height = opts.height;
-        settings.threads = opts.threads;
-        settings.seed = opts.seed;
+        RenderSettings settings = opts.renderSettings();
 
         if (opts.headless) {
             Report report;
             report.program = "04_bvh";
-            std::string out = opts.out.empty() ? "04_bvh.png" : opts.out;
-            settings.progressLabel = "04_bvh: rendering";
-            Stopwatch watch;
-            RayCounts counts;
-            Image image = renderImage(scene, scene.camera, settings, &counts);
-            double renderSeconds = watch.seconds();
-            image.writePng(out);
-            report.images.push_back({out, "scene '" + scene.name + "' through the " +
-                                              bvhBuilderName(buildOptions.builder) + " hierarchy"});
-            report.facts["render_ms"] = renderSeconds * 1e3;
-            report.facts["rays"] = counts.total();
-            std::cerr << "04_bvh: wrote " << out << " (" << image.width() << "x" << image.height()
-                      << ", " << formatSeconds(renderSeconds) << ")\n";
+            std::string out = headlessPath(opts, report.program);
+            renderHeadlessImage(scene, scene.camera, settings, out,
+                                "scene '" + scene.name + "' through the " +
+                                    bvhBuilderName(buildOptions.builder) + " hierarchy",
+                                report);
             if (geometry) {
                 const BvhBuildStats& s = geometry->stats();
                 report.facts["build_ms"] = s.buildMs;
@@ -252,7 +256,7 @@ int main(int argc, char** argv) {
                 Image map(opts.width, opts.height);
                 drawCullingMap(map, 0, opts.width, geometry->bvh(), f, CullTest::Planes, 6,
                                sceneUp);
-                std::string mapPath = withSuffix(out, "-cull");
+                std::string mapPath = pngWithSuffix(out, "-cull");
                 map.writePng(mapPath);
                 report.images.push_back(
                     {mapPath,
@@ -292,8 +296,7 @@ int main(int argc, char** argv) {
                                         {"series", "builder"},
                                         {"title", "Builders: build time against trace speed"}});
             }
-            report.write(opts.json ? std::cerr : std::cout, opts.json ? "-" : opts.reportPath);
-            if (opts.json && !opts.reportPath.empty()) report.write(std::cerr, opts.reportPath);
+            writeReport(report, opts);
             return 0;
         }
 
@@ -316,7 +319,6 @@ int main(int argc, char** argv) {
                    {SDLK_l, "show deeper boxes in the map"},
                    {SDLK_k, "show shallower boxes in the map"},
                    {SDLK_f, "far plane: through the target / 3x further"}};
-        for (const KeyBinding& k : OrbitController::keys()) cb.keys.push_back(k);
         cb.onKey = [&](int key) {
             if (key == SDLK_b && geometry) {
                 buildOptions.builder = BvhBuilder((int(buildOptions.builder) + 1) % 3);
@@ -338,13 +340,9 @@ int main(int argc, char** argv) {
                 farScale = farScale == 1.0f ? 3.0f : 1.0f;
                 return dirty = true;
             }
-            if (orbit.onKey(key)) return dirty = true;
             return false;
         };
-        cb.onMouseDrag = [&](float dx, float dy) {
-            orbit.onDrag(dx, dy);
-            dirty = true;
-        };
+        orbit.addTo(cb, [&] { dirty = true; });
         cb.frame = [&](double) -> const Image& {
             if (!dirty) return image;
             Stopwatch watch;

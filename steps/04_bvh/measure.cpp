@@ -3,6 +3,7 @@
 #include <thread>
 
 #include "01_triangle/measure.hpp"
+#include "04_bvh/bvh4.hpp"
 #include "core/timing.hpp"
 
 namespace boxes {
@@ -147,13 +148,17 @@ Table measureBvhCracks(const std::vector<NamedMesh>& meshes, size_t raysPerFeatu
         "over the first 200 rays per row against brute force";
     for (const NamedMesh& m : meshes) {
         CrackRaySet set = makeCrackRays(*m.mesh, raysPerFeature, raysPerFeature, seed);
-        for (BvhBuilder builder : kExerciseBuilders) {
+        // The exercise builders, then (width 4) the binned SAH tree collapsed (bvh4.hpp).
+        for (int variant = 0; variant <= int(std::size(kExerciseBuilders)); ++variant) {
+            bool wide = variant == int(std::size(kExerciseBuilders));
+            BvhBuilder builder = wide ? BvhBuilder::BinnedSah : kExerciseBuilders[variant];
             Bvh bvh = buildBvh(*m.mesh, optionsFor(builder, 16));
+            Bvh4 bvh4 = wide ? collapseToBvh4(bvh) : Bvh4{};
             for (int feature = 0; feature < 2; ++feature) {
                 const auto& rays = feature == 0 ? set.edgeRays : set.vertexRays;
                 size_t cracks = 0, differ = 0;
                 for (const CrackRay& cr : rays) {
-                    TraceHit h = traceNearest(bvh, cr.ray);
+                    TraceHit h = wide ? traceNearest(bvh4, cr.ray) : traceNearest(bvh, cr.ray);
                     float target = kInfinity<float>;
                     WatertightRay w(cr.ray);
                     for (uint32_t tri : cr.triangles) {
@@ -166,7 +171,8 @@ Table measureBvhCracks(const std::vector<NamedMesh>& meshes, size_t raysPerFeatu
                     if (&cr - rays.data() < 200)
                         differ += !hitsAgree(h, traceBruteForce(*m.mesh, cr.ray));
                 }
-                t.row({m.name, std::string(bvhBuilderName(builder)),
+                t.row({m.name,
+                       wide ? std::string("sah 4-wide") : std::string(bvhBuilderName(builder)),
                        std::string(feature == 0 ? "edges" : "vertices"), (long long)rays.size(),
                        (long long)cracks, (long long)differ});
             }

@@ -133,6 +133,10 @@ void traceBatch(const Bvh& bvh, const std::vector<Ray>& rays, std::vector<TraceH
     });
 }
 
+void forEachRayChunk(size_t count, int threads, const std::function<void(size_t, size_t)>& f) {
+    runBatch(count, threads, f);
+}
+
 void traceBatchBruteForce(const Mesh& mesh, const std::vector<Ray>& rays,
                           std::vector<TraceHit>& hits, int threads) {
     hits.assign(rays.size(), TraceHit{});

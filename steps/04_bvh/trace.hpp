@@ -4,6 +4,7 @@
 
 #include <cmath>
 #include <cstdint>
+#include <functional>
 #include <limits>
 #include <string>
 #include <vector>
@@ -210,6 +211,9 @@ void traceBatch(const Bvh& bvh, const std::vector<Ray>& rays, std::vector<TraceH
                 int threads);
 void traceBatchBruteForce(const Mesh& mesh, const std::vector<Ray>& rays,
                           std::vector<TraceHit>& hits, int threads);
+// The batch loop itself: f(begin, end) on chunks of [0, count), handed out dynamically to
+// `threads` threads (0: all cores). For other tracers of the step (the 4-wide one).
+void forEachRayChunk(size_t count, int threads, const std::function<void(size_t, size_t)>& f);
 
 // Does a hierarchy's hit agree with brute force: the same triangle, or the same t (two
 // triangles sharing the hit point)?

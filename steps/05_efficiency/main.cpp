@@ -20,12 +20,6 @@ using namespace boxes;
 
 namespace {
 
-std::string withSuffix(const std::string& png, const std::string& suffix) {
-    std::string stem =
-        png.size() > 4 && png.ends_with(".png") ? png.substr(0, png.size() - 4) : png;
-    return stem + suffix + ".png";
-}
-
 std::string slug(PreviewMode m) {
     switch (m) {
         case PreviewMode::Depth:
@@ -130,28 +124,14 @@ int main(int argc, char** argv) {
         }
         Camera camera = cameraFromOptions(opts, scene.camera);
         scene.camera = camera;
-        RenderSettings settings;
-        settings.width = opts.width;
-        settings.height = opts.height;
-        settings.threads = opts.threads;
-        settings.seed = opts.seed;
+        RenderSettings settings = opts.renderSettings();
 
         if (opts.headless) {
             Report report;
             report.program = "05_efficiency";
-            std::string out = opts.out.empty() ? "05_efficiency.png" : opts.out;
-            RenderSettings full = settings;
-            full.progressLabel = "05_efficiency: rendering";
-            Stopwatch watch;
-            RayCounts counts;
-            Image image = renderImage(scene, camera, full, &counts);
-            double seconds = watch.seconds();
-            image.writePng(out);
-            report.images.push_back({out, "scene '" + scene.name + "', full render"});
-            report.facts["render_ms"] = seconds * 1e3;
-            report.facts["rays"] = counts.total();
-            std::cerr << "05_efficiency: wrote " << out << " (" << image.width() << "x"
-                      << image.height() << ", " << formatSeconds(seconds) << ")\n";
+            std::string out = headlessPath(opts, report.program);
+            Image image = renderHeadlessImage(scene, camera, settings, out,
+                                              "scene '" + scene.name + "', full render", report);
             if (!noPreviews) {
                 // The same image line by line, as the window refines it: must be bit-identical.
                 Renderer renderer(scene, camera, settings);
@@ -167,7 +147,7 @@ int main(int argc, char** argv) {
                 bool identical = compareImages(incremental.image(), image).maxError == 0.0;
                 for (PreviewMode m : kAllPreviewModes) {
                     if (m == PreviewMode::Full) continue;
-                    std::string path = withSuffix(out, "-" + slug(m));
+                    std::string path = pngWithSuffix(out, "-" + slug(m));
                     renderPreview(scene, camera, m, settings, 0.25f).writePng(path);
                     report.images.push_back({path, std::string("preview: ") + previewModeName(m)});
                 }
@@ -250,8 +230,7 @@ int main(int argc, char** argv) {
                 plot("total", "ms/frame", "ratio to naive", "variant",
                      "All together: time per frame of the default scene", false, false);
             }
-            report.write(opts.json ? std::cerr : std::cout, opts.json ? "-" : opts.reportPath);
-            if (opts.json && !opts.reportPath.empty()) report.write(std::cerr, opts.reportPath);
+            writeReport(report, opts);
             return 0;
         }
 
@@ -289,7 +268,6 @@ int main(int argc, char** argv) {
                    {SDLK_0, "preview: full render every frame"},
                    {SDLK_p, "photograph: deep recursion, anti-aliasing, saves a PNG"},
                    {SDLK_ESCAPE, "cancel the photograph (quits when none runs)"}};
-        for (const KeyBinding& k : OrbitController::keys()) cb.keys.push_back(k);
         cb.onKey = [&](int key) {
             if (photo && key == SDLK_ESCAPE) {
                 photo.reset();
@@ -327,17 +305,12 @@ int main(int argc, char** argv) {
                 photoMessage.clear();
                 return true;
             }
-            if (orbit.onKey(key)) {
-                photoShown = Image();
-                return moved = true;
-            }
             return false;
         };
-        cb.onMouseDrag = [&](float dx, float dy) {
-            orbit.onDrag(dx, dy);
-            photoShown = Image();
+        orbit.addTo(cb, [&] {
+            photoShown = Image();  // a moved camera leaves the photograph
             moved = true;
-        };
+        });
         cb.frame = [&](double) -> const Image& {
             if (photo) {
                 photo->advance(photoBudget);

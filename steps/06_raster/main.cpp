@@ -25,12 +25,6 @@ ShadowMode parseShadows(const std::string& name) {
     return ShadowMode::Rays;
 }
 
-std::string withSuffix(const std::string& png, const std::string& suffix) {
-    std::string stem =
-        png.size() > 4 && png.ends_with(".png") ? png.substr(0, png.size() - 4) : png;
-    return stem + suffix;
-}
-
 template <typename T>
 void writeBuffer(const std::string& path, const std::vector<T>& values) {
     writeFileAtomically(path, values.data(), values.size() * sizeof(T));
@@ -114,7 +108,7 @@ int main(int argc, char** argv) {
         if (opts.headless) {
             Report report;
             report.program = "06_raster";
-            std::string out = opts.out.empty() ? "06_raster.png" : opts.out;
+            std::string out = headlessPath(opts, report.program);
             FrameBuffers buffers;
             FrameStats stats = rasterizeCulled(raster, culling ? culler.get() : nullptr,
                                                scene.camera, rs, buffers, cull);
@@ -154,7 +148,7 @@ int main(int argc, char** argv) {
                 VisibilityComparison c = compareVisibility(
                     rs.width, rs.height, meshIds(raster, buffers), meshDepths(raster, buffers),
                     traced.ids, traced.depth, &scene.mesh);
-                std::string diff = withSuffix(out, "-diff.png");
+                std::string diff = pngWithSuffix(out, "-diff");
                 differenceImage(rs.width, rs.height, meshIds(raster, buffers), traced.ids)
                     .writePng(diff);
                 report.images.push_back(
@@ -207,7 +201,7 @@ int main(int argc, char** argv) {
                 report.add(measureShadowBias(views[0], ms));
                 report.add(measureShadowMethods(views[0], ms));
                 std::cerr << "06_raster: interpolation...\n";
-                report.add(measureInterpolation(views[0], ms, withSuffix(out, ""), report.images));
+                report.add(measureInterpolation(views[0], ms, pngStem(out), report.images));
                 report.plots.push_back(
                     {{"table", "shadow_bias"},
                      {"x", "bias (x diagonal)"},
@@ -216,10 +210,8 @@ int main(int argc, char** argv) {
                      {"logx", true},
                      {"title", "Shadow map bias: acne at small bias, peter-panning at large"}});
             }
-            if (opts.json || !opts.reportPath.empty() || measure || compare) {
-                report.write(opts.json ? std::cerr : std::cout, opts.json ? "-" : opts.reportPath);
-                if (opts.json && !opts.reportPath.empty()) report.write(std::cerr, opts.reportPath);
-            }
+            if (opts.json || !opts.reportPath.empty() || measure || compare)
+                writeReport(report, opts);
             return 0;
         }
 
@@ -232,10 +224,7 @@ int main(int argc, char** argv) {
         double rasterMs = 0.0, shadeMs = 0.0, tracedMs = 0.0;
         FrameStats stats;
         VisibilityComparison diff;
-        RenderSettings settings;
-        settings.width = opts.width;
-        settings.height = opts.height;
-        settings.threads = opts.threads;
+        RenderSettings settings = opts.renderSettings();
         WindowCallbacks cb;
         cb.keys = {{SDLK_r, "switch rasterizer / ray tracer (same view)"},
                    {SDLK_d,
@@ -246,7 +235,6 @@ int main(int argc, char** argv) {
                    {SDLK_p, "perspective-correct / affine interpolation"},
                    {SDLK_c, "checker on the surfaces (shows the interpolation)"},
                    {SDLK_f, "frustum culling with step 04's hierarchy on / off"}};
-        for (const KeyBinding& k : OrbitController::keys()) cb.keys.push_back(k);
         cb.onKey = [&](int key) {
             switch (key) {
                 case SDLK_r:
@@ -267,15 +255,15 @@ int main(int argc, char** argv) {
                 case SDLK_c:
                     ss.checker = !ss.checker;
                     break;
+                case SDLK_f:
+                    culling = !culling;
+                    break;
                 default:
-                    if (!orbit.onKey(key)) return false;
+                    return false;
             }
             return dirty = true;
         };
-        cb.onMouseDrag = [&](float dx, float dy) {
-            orbit.onDrag(dx, dy);
-            dirty = true;
-        };
+        orbit.addTo(cb, [&] { dirty = true; });
         cb.frame = [&](double) -> const Image& {
             if (!dirty) return image;
             const Camera& camera = orbit.camera();

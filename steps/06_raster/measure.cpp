@@ -14,16 +14,6 @@ namespace boxes {
 
 namespace {
 
-Camera lookAt(Vec3 eye, Vec3 target, Vec3 up, float fov, float aspect) {
-    Camera c;
-    c.eye = eye;
-    c.view = target - eye;
-    c.up = up;
-    c.fovYDegrees = fov;
-    c.aspect = aspect;
-    return c;
-}
-
 RasterSettings rasterSettings(const MeasureSettings& m) {
     RasterSettings s;
     s.width = m.width;
@@ -72,7 +62,8 @@ std::vector<MeasureView> measureViews(const std::string& dataDir, const std::str
     }
     if (!sharedMeshes.empty()) {
         MeasureView v{"oa_thor (inside)", makeScene(sharedMeshes + "/oa_thor.obj", options), {}};
-        v.camera = lookAt(Vec3(960, -384, 2), Vec3(960, 600, 2), Vec3(0, 0, 1), 90.0f, aspect);
+        v.camera =
+            Camera::lookingAt(Vec3(960, -384, 2), Vec3(960, 600, 2), Vec3(0, 0, 1), 90.0f, aspect);
         views.push_back(std::move(v));
     }
     for (MeasureView& v : views) attachGrid(v.scene);
@@ -311,8 +302,8 @@ Table measureInterpolation(const MeasureView& bunny, const MeasureSettings& m,
     floor.scene.mesh.triangles = {{0, 2, 1}, {0, 3, 2}};
     floor.scene.mesh.computeVertexNormals();
     floor.scene.lights.push_back({Vec3(0, 6, 0), Vec3(60.0f), kInfinity<float>});
-    floor.camera = lookAt(Vec3(0, 2.5f, 13.0f), Vec3(0, 0, 2.0f), Vec3(0, 1, 0), 60.0f,
-                          float(m.width) / float(m.height));
+    floor.camera = Camera::lookingAt(Vec3(0, 2.5f, 13.0f), Vec3(0, 0, 2.0f), Vec3(0, 1, 0), 60.0f,
+                                     float(m.width) / float(m.height));
     attachGrid(floor.scene);
     for (const MeasureView* v : {static_cast<const MeasureView*>(&floor), &bunny}) {
         RasterScene raster = RasterScene::fromScene(v->scene);

@@ -1,0 +1,434 @@
+// Step 04, the advanced variant (not an exercise): a 4-wide hierarchy traversed with SIMD.
+//
+// Layout (as Embree's BVH4 and tinybvh's BVH4): one node holds its four children's boxes
+// "structure of arrays", minimum x of the four children in one float[4], then minimum y, ...,
+// so one SSE load brings one plane of all four boxes, and one ray is tested against the
+// four boxes at once. 128 bytes, aligned to two 64-byte cache lines. A child is an inner
+// node (count 0, child = its node index), a leaf (count > 0, child = its first slot) or
+// an empty slot (an inverted box no ray enters).
+//
+// Built by collapsing a binary tree (Dammertz, Hanika, Keller 2008, "Shallow bounding
+// volume hierarchies for fast SIMD ray tracing of incoherent rays"; Wald, Benthin, Boulos
+// 2008, "Getting rid of packets"): a node starts with its two children, and while it has
+// fewer than four, the inner child with the largest surface area (the one a ray most likely
+// enters) is replaced by its own two children. The binary tree's leaves stay leaves, and a
+// subtree of at most 8 triangles becomes one leaf (two packets for the 4-triangle test);
+// leaves are stored as packets of four triangles, "structure of arrays" as well.
+//
+// Traversal is conservative exactly as the scalar one: the same margin-shifted origins,
+// the same operations in the same order, kBoxFarScale on the far distance, and a NaN from
+// 0 * infinity (origin in a slab plane, zero direction component) ignored (the min/max
+// operand order below). The four entry distances and the scalar test's agree bit for bit.
+#pragma once
+
+#include <bit>
+#include <cstdint>
+#include <vector>
+
+#include "04_bvh/bvh.hpp"
+#include "04_bvh/trace.hpp"
+
+#if defined(__SSE2__)
+#include <emmintrin.h>
+#endif
+
+namespace boxes {
+
+struct alignas(64) Bvh4Node {
+    float boundsMin[3][4];  // [axis][child]
+    float boundsMax[3][4];
+    uint32_t child[4];  // inner child: node index; leaf: first slot; empty: 0
+    uint32_t count[4];  // 0: inner child (or empty slot), else the leaf's size
+
+    bool isLeaf(int i) const { return count[i] != 0; }
+    Bounds3f bounds(int i) const {
+        return {Vec3(boundsMin[0][i], boundsMin[1][i], boundsMin[2][i]),
+                Vec3(boundsMax[0][i], boundsMax[1][i], boundsMax[2][i])};
+    }
+    // An empty slot: an inverted box (+inf .. -inf) that every ray misses, NaN-free.
+    bool isEmpty(int i) const { return count[i] == 0 && boundsMin[0][i] > boundsMax[0][i]; }
+};
+static_assert(sizeof(Bvh4Node) == 128, "two 64-byte cache lines");
+
+// Four triangles "structure of arrays" (vertex, axis, lane) for the 4-triangle leaf test.
+struct alignas(16) TrianglePacket4 {
+    float vertex[3][3][4];
+};
+
+// Slots are regrouped by four: every leaf starts a packet (slot first = 4 * packet), and
+// the lanes after a leaf's last triangle repeat that triangle (same primitive index), so
+// a leaf's slots [first, first + count) are packet lanes and a packet never mixes leaves.
+struct Bvh4 {
+    std::vector<Bvh4Node> nodes;  // nodes[0] is the root (when not empty); alignas: new aligns
+    std::vector<uint32_t> primitiveIndices;   // slot -> primitive
+    std::vector<LeafTriangle> leafTriangles;  // meshes only: slot -> vertices
+    std::vector<TrianglePacket4> packets;     // meshes only: the same by four
+    Bounds3f rootBounds;
+
+    bool empty() const { return nodes.empty(); }
+    Bounds3f bounds() const { return rootBounds; }
+};
+
+// Collapses a binary hierarchy: its leaves are kept, and so is any subtree of at most
+// kBvh4MergedLeafSize primitives, as one leaf; their slots are regrouped into packets.
+constexpr uint32_t kBvh4MergedLeafSize = 8;
+Bvh4 collapseToBvh4(const Bvh& binary);
+
+struct Bvh4Stats {
+    size_t nodes = 0, leaves = 0, emptySlots = 0;
+    int depth = 0;  // the deepest leaf; children of the root are depth 1
+};
+Bvh4Stats bvh4Stats(const Bvh4& bvh);
+
+// A ray prepared for the four-box test: per axis the offset (in floats into a node) of the
+// plane array met first and of the one met last, and broadcast origins and 1/d.
+struct Bvh4Ray {
+    int nearOffset[3], farOffset[3];
+    float nearOrigin[3], farOrigin[3], inverseDirection[3], tmin;
+#if defined(__SSE2__)
+    __m128 nearOriginV[3], farOriginV[3], inverseDirectionV[3], tminV;
+#endif
+    explicit Bvh4Ray(const TraversalRay& ray) : tmin(ray.tmin) {
+        for (int axis = 0; axis < 3; ++axis) {
+            bool positive = ray.nearOffset[axis] == axis;  // the min plane first
+            nearOffset[axis] = positive ? 4 * axis : 12 + 4 * axis;
+            farOffset[axis] = positive ? 12 + 4 * axis : 4 * axis;
+            nearOrigin[axis] = ray.nearOrigin[axis];
+            farOrigin[axis] = ray.farOrigin[axis];
+            inverseDirection[axis] = (&ray.inverseDirection.x)[axis];
+#if defined(__SSE2__)
+            nearOriginV[axis] = _mm_set1_ps(nearOrigin[axis]);
+            farOriginV[axis] = _mm_set1_ps(farOrigin[axis]);
+            inverseDirectionV[axis] = _mm_set1_ps(inverseDirection[axis]);
+#endif
+        }
+#if defined(__SSE2__)
+        tminV = _mm_set1_ps(tmin);
+#endif
+    }
+};
+
+// The slab test of one ray against a node's four boxes in [ray.tmin, tmax]: bit i of the
+// result is set when the ray enters box i, at tEntry[i]. Per box, the same arithmetic as
+// intersectNodeBounds.
+inline int intersectChildBounds(const Bvh4Node& node, const Bvh4Ray& ray, float tmax,
+                                float tEntry[4]) {
+    const float* planes = &node.boundsMin[0][0];
+#if defined(__SSE2__)
+    __m128 t0 = ray.tminV, t1 = _mm_set1_ps(tmax);
+    const __m128 farScale = _mm_set1_ps(kBoxFarScale);
+    for (int axis = 0; axis < 3; ++axis) {
+        __m128 tNear = _mm_mul_ps(
+            _mm_sub_ps(_mm_load_ps(planes + ray.nearOffset[axis]), ray.nearOriginV[axis]),
+            ray.inverseDirectionV[axis]);
+        __m128 tFar = _mm_mul_ps(
+            _mm_mul_ps(_mm_sub_ps(_mm_load_ps(planes + ray.farOffset[axis]), ray.farOriginV[axis]),
+                       ray.inverseDirectionV[axis]),
+            farScale);
+        // maxps/minps return the second operand when either is NaN: the running bound
+        // goes second, so a NaN plane distance is ignored (as `tNear > t0 ? tNear : t0`).
+        t0 = _mm_max_ps(tNear, t0);
+        t1 = _mm_min_ps(tFar, t1);
+    }
+    _mm_storeu_ps(tEntry, t0);
+    // Empty slots (min > max) are masked out: with a non-finite origin (coordinates near
+    // the float range's end) every slab distance is NaN and every box looks entered.
+    __m128 filled = _mm_cmple_ps(_mm_load_ps(planes), _mm_load_ps(planes + 12));
+    return _mm_movemask_ps(_mm_and_ps(_mm_cmple_ps(t0, t1), filled));
+#else
+    int mask = 0;
+    for (int i = 0; i < 4; ++i) {
+        float t0 = ray.tmin, t1 = tmax;
+        for (int axis = 0; axis < 3; ++axis) {
+            float tNear = (planes[ray.nearOffset[axis] + i] - ray.nearOrigin[axis]) *
+                          ray.inverseDirection[axis];
+            float tFar = (planes[ray.farOffset[axis] + i] - ray.farOrigin[axis]) *
+                         ray.inverseDirection[axis] * kBoxFarScale;
+            t0 = tNear > t0 ? tNear : t0;
+            t1 = tFar < t1 ? tFar : t1;
+        }
+        tEntry[i] = t0;
+        mask |= int(t0 <= t1 && planes[i] <= planes[12 + i]) << i;  // not an empty slot
+    }
+    return mask;
+#endif
+}
+
+// Asks for a postponed child's first cache lines: its fetch then overlaps the work on the
+// nearer children (incoherent rays spend most of their time waiting for nodes).
+inline void prefetchChild(const Bvh4& bvh, uint32_t child, uint32_t count) {
+#if defined(__SSE2__)
+    const char* p = count == 0 ? reinterpret_cast<const char*>(&bvh.nodes[child])
+                               : reinterpret_cast<const char*>(&bvh.packets[child / 4]);
+    _mm_prefetch(p, _MM_HINT_T0);
+    _mm_prefetch(p + 64, _MM_HINT_T0);
+#else
+    (void)bvh, (void)child, (void)count;
+#endif
+}
+
+// Inner children push up to three entries per level, and the builders cap the depth at
+// kTraversalStackSize / 2 = 64.
+constexpr int kBvh4StackSize = 256;
+// A 4-wide node may span one binary level on a path and still push 3 entries.
+static_assert(kBvh4StackSize > 3 * (kTraversalStackSize / 2) + 4, "the builders' depth cap");
+
+// Nearest hit, nearest child first, early out. intersectLeaf(first, count, tClosest) tests
+// a leaf's slots [first, first + count), lowers tClosest on a hit and returns the slot of
+// its nearest hit (or kTraversalMiss). Returns the slot of the nearest hit or kTraversalMiss.
+template <typename LeafIntersector>
+uint32_t traverseNearest4Leaves(const Bvh4& bvh, const TraversalRay& traversal, float& tClosest,
+                                LeafIntersector&& intersectLeaf) {
+    if (bvh.empty()) return kTraversalMiss;
+    const Bvh4Ray ray(traversal);
+    const Bvh4Node* nodes = bvh.nodes.data();
+    struct Entry {
+        uint32_t child, count;
+        float tEntry;
+    } stack[kBvh4StackSize];
+    int stackSize = 0;
+    uint32_t nearestSlot = kTraversalMiss;
+    uint32_t child = 0, count = 0;  // the root, an inner node
+    for (;;) {
+        if (count == 0) {
+            const Bvh4Node& node = nodes[child];
+            alignas(16) float t[4];
+            int mask = intersectChildBounds(node, ray, tClosest, t);
+            if (mask != 0) {
+                int first = std::countr_zero(unsigned(mask));
+                mask &= mask - 1;
+                if (mask == 0) {  // one child: descend, nothing to keep
+                    child = node.child[first];
+                    count = node.count[first];
+                    continue;
+                }
+                // Two to four: sorted farthest first onto the stack, the nearest descended.
+                Entry hit[4];
+                hit[0] = {node.child[first], node.count[first], t[first]};
+                int hits = 1;
+                while (mask != 0) {
+                    int i = std::countr_zero(unsigned(mask));
+                    mask &= mask - 1;
+                    Entry e{node.child[i], node.count[i], t[i]};
+                    int j = hits++;
+                    for (; j > 0 && hit[j - 1].tEntry < e.tEntry; --j) hit[j] = hit[j - 1];
+                    hit[j] = e;
+                }
+                for (int j = 0; j < hits - 1; ++j) {
+                    stack[stackSize++] = hit[j];
+                    prefetchChild(bvh, hit[j].child, hit[j].count);
+                }
+                child = hit[hits - 1].child;
+                count = hit[hits - 1].count;
+                continue;
+            }
+        } else {
+            uint32_t slot = intersectLeaf(child, count, tClosest);
+            if (slot != kTraversalMiss) nearestSlot = slot;
+        }
+        // Pop until an entry the ray enters before the nearest hit so far.
+        for (;;) {
+            if (stackSize == 0) return nearestSlot;
+            const Entry& e = stack[--stackSize];
+            if (e.tEntry <= tClosest) {
+                child = e.child;
+                count = e.count;
+                break;
+            }
+        }
+    }
+}
+
+// The same with the interface of traverseNearest: intersect(slot, tClosest) per slot.
+template <typename PrimitiveIntersector>
+uint32_t traverseNearest4(const Bvh4& bvh, const TraversalRay& traversal, float& tClosest,
+                          PrimitiveIntersector&& intersect) {
+    return traverseNearest4Leaves(bvh, traversal, tClosest,
+                                  [&](uint32_t first, uint32_t count, float& tmax) {
+                                      uint32_t nearest = kTraversalMiss;
+                                      for (uint32_t slot = first; slot < first + count; ++slot)
+                                          if (intersect(slot, tmax)) nearest = slot;
+                                      return nearest;
+                                  });
+}
+
+// Any hit in [ray.tmin, ray.tmax] (shadow rays): no order, stop at the first hit.
+// intersectLeaf(first, count, tmax) is true when a slot of the leaf is hit.
+template <typename LeafIntersector>
+bool traverseAny4Leaves(const Bvh4& bvh, const TraversalRay& traversal,
+                        LeafIntersector&& intersectLeaf) {
+    if (bvh.empty()) return false;
+    const Bvh4Ray ray(traversal);
+    const Bvh4Node* nodes = bvh.nodes.data();
+    struct Entry {
+        uint32_t child, count;
+    } stack[kBvh4StackSize];
+    int stackSize = 0;
+    stack[stackSize++] = {0, 0};
+    while (stackSize > 0) {
+        Entry e = stack[--stackSize];
+        if (e.count != 0) {
+            if (intersectLeaf(e.child, e.count, traversal.tmax)) return true;
+            continue;
+        }
+        const Bvh4Node& node = nodes[e.child];
+        alignas(16) float t[4];
+        int mask = intersectChildBounds(node, ray, traversal.tmax, t);
+        while (mask != 0) {
+            int i = std::countr_zero(unsigned(mask));
+            mask &= mask - 1;
+            stack[stackSize++] = {node.child[i], node.count[i]};
+        }
+    }
+    return false;
+}
+
+template <typename PrimitiveIntersector>
+bool traverseAny4(const Bvh4& bvh, const TraversalRay& traversal,
+                  PrimitiveIntersector&& intersect) {
+    return traverseAny4Leaves(bvh, traversal, [&](uint32_t first, uint32_t count, float tmax) {
+        for (uint32_t slot = first; slot < first + count; ++slot)
+            if (intersect(slot, tmax)) return true;
+        return false;
+    });
+}
+
+// The margin of the scalar traversal, from the same root bounds.
+inline float traversalMargin(const Ray& ray, const Bvh4& bvh) {
+    return bvh.empty() ? 0.0f : TraversalRay::marginFor(ray, bvh.bounds());
+}
+
+// The watertight test (intersectLeafTriangle) on the four triangles of a packet at once:
+// the same operations in the same order per lane, so every lane's u, v, w, det and t are
+// bit for bit the scalar test's. Lanes the scalar test would decide in double (an edge
+// function exactly 0, a non-finite det, a scaled t below the normal range) are handed to
+// it, one by one. Tests a leaf's slots [first, first + count) (first a multiple of 4) in
+// [ray.tmin, tClosest]; lowers tClosest to the nearest hit and returns its slot, or
+// kTraversalMiss. The sign test reads sign bits: for lanes whose u, v, w are all non-zero,
+// "some negative and some positive" is "the sign bits differ".
+struct WatertightRay4 {
+#if defined(__SSE2__)
+    __m128 origin[3], sx, sy, sz, tmin;
+    explicit WatertightRay4(const WatertightRay& r)
+        : origin{_mm_set1_ps(r.origin.x), _mm_set1_ps(r.origin.y), _mm_set1_ps(r.origin.z)},
+          sx(_mm_set1_ps(r.sx)),
+          sy(_mm_set1_ps(r.sy)),
+          sz(_mm_set1_ps(r.sz)),
+          tmin(_mm_set1_ps(r.tmin)) {}
+#else
+    explicit WatertightRay4(const WatertightRay&) {}
+#endif
+};
+
+template <typename Axes>
+inline uint32_t intersectLeafPackets(Axes axes, const WatertightRay& r, const WatertightRay4& r4,
+                                     const Bvh4& bvh, uint32_t first, uint32_t count,
+                                     float& tClosest) {
+    uint32_t nearest = kTraversalMiss;
+#if defined(__SSE2__)
+    constexpr int kx = Axes::kx, ky = Axes::ky, kz = Axes::kz;
+    const __m128 zero = _mm_setzero_ps(), one = _mm_set1_ps(1.0f);
+    const __m128i absMask = _mm_set1_epi32(0x7FFFFFFF);
+    for (uint32_t base = first; base < first + count; base += 4) {
+        const TrianglePacket4& p = bvh.packets[base / 4];
+        auto rel = [&](int v, int axis) {
+            return _mm_sub_ps(_mm_load_ps(p.vertex[v][axis]), r4.origin[axis]);
+        };
+        const __m128 aKz = rel(0, kz), bKz = rel(1, kz), cKz = rel(2, kz);
+        const __m128 ax = _mm_sub_ps(rel(0, kx), _mm_mul_ps(r4.sx, aKz));
+        const __m128 ay = _mm_sub_ps(rel(0, ky), _mm_mul_ps(r4.sy, aKz));
+        const __m128 bx = _mm_sub_ps(rel(1, kx), _mm_mul_ps(r4.sx, bKz));
+        const __m128 by = _mm_sub_ps(rel(1, ky), _mm_mul_ps(r4.sy, bKz));
+        const __m128 cx = _mm_sub_ps(rel(2, kx), _mm_mul_ps(r4.sx, cKz));
+        const __m128 cy = _mm_sub_ps(rel(2, ky), _mm_mul_ps(r4.sy, cKz));
+        __m128 u = _mm_sub_ps(_mm_mul_ps(cx, by), _mm_mul_ps(cy, bx));
+        __m128 v = _mm_sub_ps(_mm_mul_ps(ax, cy), _mm_mul_ps(ay, cx));
+        __m128 w = _mm_sub_ps(_mm_mul_ps(bx, ay), _mm_mul_ps(by, ax));
+        const __m128 det = _mm_add_ps(_mm_add_ps(u, v), w);
+        // Lanes for the scalar test: an edge function exactly 0 (cmpeq is a quiet compare),
+        // or det not finite (exponent bits all ones; integer compares raise nothing).
+        const __m128 anyZero = _mm_or_ps(_mm_or_ps(_mm_cmpeq_ps(u, zero), _mm_cmpeq_ps(v, zero)),
+                                         _mm_cmpeq_ps(w, zero));
+        const __m128 notFinite = _mm_castsi128_ps(_mm_cmpgt_epi32(
+            _mm_and_si128(_mm_castps_si128(det), absMask), _mm_set1_epi32(0x7F7FFFFF)));
+        __m128 scalar = _mm_or_ps(anyZero, notFinite);
+        const __m128 mixedSigns = _mm_castsi128_ps(
+            _mm_srai_epi32(_mm_castps_si128(_mm_or_ps(_mm_xor_ps(u, v), _mm_xor_ps(u, w))), 31));
+        // Lanes that go on to t: all signs equal, decided here (det != 0 follows).
+        const __m128 onward =
+            _mm_andnot_ps(_mm_or_ps(scalar, mixedSigns), _mm_cmpneq_ps(det, zero));
+        // Zero the others' edge functions and give them det 1: their t is then 0 / 1, no
+        // spurious overflow or 0 / 0 where the scalar test would not have computed t.
+        u = _mm_and_ps(u, onward);
+        v = _mm_and_ps(v, onward);
+        w = _mm_and_ps(w, onward);
+        const __m128 divisor = _mm_or_ps(_mm_and_ps(det, onward), _mm_andnot_ps(onward, one));
+        const __m128 tScaled = _mm_add_ps(_mm_add_ps(_mm_mul_ps(u, _mm_mul_ps(r4.sz, aKz)),
+                                                     _mm_mul_ps(v, _mm_mul_ps(r4.sz, bKz))),
+                                          _mm_mul_ps(w, _mm_mul_ps(r4.sz, cKz)));
+        const __m128 tiny = _mm_castsi128_ps(_mm_cmplt_epi32(
+            _mm_and_si128(_mm_castps_si128(tScaled), absMask), _mm_set1_epi32(0x00800000)));
+        scalar = _mm_or_ps(scalar, _mm_and_ps(tiny, onward));
+        const __m128 t = _mm_div_ps(tScaled, divisor);
+        const __m128 tmax = _mm_set1_ps(tClosest);
+        __m128 hit = _mm_andnot_ps(tiny, onward);
+        hit = _mm_and_ps(hit, _mm_and_ps(_mm_cmpge_ps(t, r4.tmin), _mm_cmple_ps(t, tmax)));
+        const uint32_t lanes = std::min(4u, first + count - base);
+        const int live = (1 << lanes) - 1;  // the lanes after a leaf's end repeat its last
+        int hitMask = _mm_movemask_ps(hit) & live;
+        if (hitMask != 0) {
+            __m128 tHit =
+                _mm_or_ps(_mm_and_ps(hit, t), _mm_andnot_ps(hit, _mm_set1_ps(kInfinity<float>)));
+            __m128 m = _mm_min_ps(tHit, _mm_shuffle_ps(tHit, tHit, _MM_SHUFFLE(2, 3, 0, 1)));
+            m = _mm_min_ps(m, _mm_shuffle_ps(m, m, _MM_SHUFFLE(1, 0, 3, 2)));
+            int lane = std::countr_zero(unsigned(_mm_movemask_ps(_mm_cmpeq_ps(tHit, m)) & hitMask));
+            tClosest = _mm_cvtss_f32(m);
+            nearest = base + uint32_t(lane);
+        }
+        int scalarMask = _mm_movemask_ps(scalar) & live;
+        while (scalarMask != 0) [[unlikely]] {
+                uint32_t slot = base + uint32_t(std::countr_zero(unsigned(scalarMask)));
+                scalarMask &= scalarMask - 1;
+                if (intersectLeafTriangle(axes, r, bvh.leafTriangles[slot], tClosest))
+                    nearest = slot;
+            }
+    }
+#else
+    (void)r4;
+    for (uint32_t slot = first; slot < first + count; ++slot)
+        if (intersectLeafTriangle(axes, r, bvh.leafTriangles[slot], tClosest)) nearest = slot;
+#endif
+    return nearest;
+}
+
+inline TraceHit traceNearest(const Bvh4& bvh, const Ray& ray) {
+    TraversalRay traversal(ray, traversalMargin(ray, bvh));
+    WatertightRay watertight(ray);
+    WatertightRay4 watertight4(watertight);
+    float tClosest = ray.tmax;
+    uint32_t slot = withWatertightAxes(watertight, [&](auto axes) {
+        return traverseNearest4Leaves(
+            bvh, traversal, tClosest, [&](uint32_t first, uint32_t count, float& tmax) {
+                return intersectLeafPackets(axes, watertight, watertight4, bvh, first, count, tmax);
+            });
+    });
+    if (slot == kTraversalMiss) return {};
+    return {tClosest, bvh.primitiveIndices[slot]};
+}
+
+inline bool traceOccluded(const Bvh4& bvh, const Ray& ray) {
+    TraversalRay traversal(ray, traversalMargin(ray, bvh));
+    WatertightRay watertight(ray);
+    WatertightRay4 watertight4(watertight);
+    return withWatertightAxes(watertight, [&](auto axes) {
+        return traverseAny4Leaves(bvh, traversal, [&](uint32_t first, uint32_t count, float tmax) {
+            return intersectLeafPackets(axes, watertight, watertight4, bvh, first, count, tmax) !=
+                   kTraversalMiss;
+        });
+    });
+}
+
+void traceBatch(const Bvh4& bvh, const std::vector<Ray>& rays, std::vector<TraceHit>& hits,
+                int threads);
+
+}  // namespace boxes

@@ -1,6 +1,13 @@
 // The builders: the recursive framework and the split rules (exercises 4.1 to 4.3).
 #include <algorithm>
+#include <cstdint>
 #include <numeric>
+#if defined(__linux__)
+#include <sys/mman.h>
+#endif
+#if defined(__SSE2__)
+#include <immintrin.h>
+#endif
 
 #include "04_bvh/bvh.hpp"
 #include "core/timing.hpp"
@@ -62,15 +69,79 @@ inline float component(const Vec3& v, int axis) {
     return (&v.x)[axis];
 }
 
-struct SahBin {
-    Vec3 lo, hi;  // bounds of the primitives in the bin
-    uint32_t count;
-};
-
 inline float area(const Vec3& lo, const Vec3& hi) {
     Vec3 d = hi - lo;
     return 2.0f * (d.x * d.y + d.y * d.z + d.z * d.x);
 }
+
+// Bounds that a build loop extends once per primitive: the framework's pass over a node
+// and the binned SAH's bins. With SSE each of min and max is one 4-wide register (x, y,
+// z and a 4th lane that is never read), so extending by a primitive's box is one min and
+// one max instead of six scalar operations; elsewhere three floats, the same results.
+// Trivial on purpose: an array of 768 bins costs nothing until a bin is set to empty().
+struct PackedBounds {
+#if defined(__SSE2__)
+    __m128 lo, hi;
+
+    static PackedBounds empty() {
+        return {_mm_set1_ps(kInfinity<float>), _mm_set1_ps(-kInfinity<float>)};
+    }
+    // By the primitive's box: bounds.min and bounds.max read as 4 floats each (the 4th is
+    // the next member's, inside the same BuildPrimitive, and ends in the unused lane).
+    void extend(const BuildPrimitive& p) {
+        lo = _mm_min_ps(lo, _mm_loadu_ps(&p.bounds.min.x));
+        hi = _mm_max_ps(hi, _mm_loadu_ps(&p.bounds.max.x));
+    }
+    // By the primitive's centroid (the 4th lane a copy of z, not the index's bits).
+    void extendByCentroid(const BuildPrimitive& p) {
+        __m128 c = _mm_loadu_ps(&p.centroid.x);
+        c = _mm_shuffle_ps(c, c, _MM_SHUFFLE(2, 2, 1, 0));
+        lo = _mm_min_ps(lo, c);
+        hi = _mm_max_ps(hi, c);
+    }
+    void extend(const PackedBounds& b) {
+        lo = _mm_min_ps(lo, b.lo);
+        hi = _mm_max_ps(hi, b.hi);
+    }
+    Bounds3f bounds() const {
+        alignas(16) float l[4], h[4];
+        _mm_store_ps(l, lo);
+        _mm_store_ps(h, hi);
+        return {Vec3(l[0], l[1], l[2]), Vec3(h[0], h[1], h[2])};
+    }
+#else
+    Vec3 lo, hi;
+
+    static PackedBounds empty() {
+        return {Vec3(kInfinity<float>), Vec3(-kInfinity<float>)};
+    }
+    void extend(const BuildPrimitive& p) {
+        lo = glm::min(lo, p.bounds.min);
+        hi = glm::max(hi, p.bounds.max);
+    }
+    void extendByCentroid(const BuildPrimitive& p) {
+        lo = glm::min(lo, p.centroid);
+        hi = glm::max(hi, p.centroid);
+    }
+    void extend(const PackedBounds& b) {
+        lo = glm::min(lo, b.lo);
+        hi = glm::max(hi, b.hi);
+    }
+    Bounds3f bounds() const {
+        return {lo, hi};
+    }
+#endif
+    // Only for bounds that contain something (an empty box has no meaningful area).
+    float surfaceArea() const {
+        Bounds3f b = bounds();
+        return area(b.min, b.max);
+    }
+};
+
+struct SahBin {
+    PackedBounds bounds;  // of the primitives in the bin
+    uint32_t count;
+};
 
 }  // namespace
 
@@ -84,6 +155,20 @@ size_t partitionBinnedSah(std::span<BuildPrimitive> prims, const Bounds3f& nodeB
     float nodeArea = nodeBounds.surfaceArea();
     // A node without area (all primitives on one line) gives no guidance: no split.
     if (!(nodeArea > 0.0f)) return 0;
+    // Two primitives (a third of the calls): the only split puts one on each side; it is
+    // the plane the bins would find on the first axis where the centroids differ.
+    if (prims.size() == 2) {
+        for (int axis = 0; axis < 3; ++axis) {
+            float a = component(prims[0].centroid, axis), b = component(prims[1].centroid, axis);
+            if (a == b) continue;
+            if (b < a) std::swap(prims[0], prims[1]);
+            cost = options.traversalCost +
+                   options.intersectionCost *
+                       (prims[0].bounds.surfaceArea() + prims[1].bounds.surfaceArea()) / nodeArea;
+            return 1;
+        }
+        return 0;
+    }
     int bestAxis = -1, bestPlane = 0;
     // Per axis: the bin scale (0 for an axis with zero extent: nothing to split there, and
     // a division by zero otherwise). All three axes are binned in one pass over the
@@ -99,60 +184,68 @@ size_t partitionBinnedSah(std::span<BuildPrimitive> prims, const Bounds3f& nodeB
     if (scale[0] == 0.0f && scale[1] == 0.0f && scale[2] == 0.0f) return 0;
     SahBin bin[3][kMaxBins];
     for (int axis = 0; axis < 3; ++axis)
-        for (int b = 0; b < bins; ++b)
-            bin[axis][b] = {Vec3(kInfinity<float>), Vec3(-kInfinity<float>), 0};
+        for (int b = 0; b < bins; ++b) bin[axis][b] = {PackedBounds::empty(), 0};
     for (const BuildPrimitive& p : prims) {
         for (int axis = 0; axis < 3; ++axis) {
             int b =
                 std::min(bins - 1, int((component(p.centroid, axis) - lowest[axis]) * scale[axis]));
             SahBin& into = bin[axis][b];
             into.count++;
-            into.lo = glm::min(into.lo, p.bounds.min);
-            into.hi = glm::max(into.hi, p.bounds.max);
+            into.bounds.extend(p);
         }
     }
     for (int axis = 0; axis < 3; ++axis) {
         if (scale[axis] == 0.0f) continue;
         const SahBin* axisBins = bin[axis];
-        // Sweep from the right: area and count right of each plane; then from the left.
+        // Only the occupied bins matter: a plane between empty bins repeats its neighbour's
+        // split, and a small node fills few of its bins. List them (without a branch).
+        int occupied[kMaxBins], used = 0;
+        for (int b = 0; b < bins; ++b) {
+            occupied[used] = b;
+            used += axisBins[b].count > 0 ? 1 : 0;
+        }
+        // Sweep from the right: area and count of the occupied bins j.. (the primitives
+        // right of the plane before bin occupied[j]); then from the left, pricing each plane.
         float rightArea[kMaxBins];
         uint32_t rightCount[kMaxBins];
-        Vec3 lo(kInfinity<float>), hi(-kInfinity<float>);
+        PackedBounds side = PackedBounds::empty();
         uint32_t count = 0;
-        for (int plane = bins - 1; plane > 0; --plane) {
-            count += axisBins[plane].count;
-            lo = glm::min(lo, axisBins[plane].lo);
-            hi = glm::max(hi, axisBins[plane].hi);
-            rightArea[plane] = count ? area(lo, hi) : 0.0f;
-            rightCount[plane] = count;
+        for (int j = used - 1; j > 0; --j) {
+            count += axisBins[occupied[j]].count;
+            side.extend(axisBins[occupied[j]].bounds);
+            rightArea[j] = side.surfaceArea();
+            rightCount[j] = count;
         }
-        lo = Vec3(kInfinity<float>);
-        hi = Vec3(-kInfinity<float>);
+        side = PackedBounds::empty();
         count = 0;
-        for (int plane = 1; plane < bins; ++plane) {
-            count += axisBins[plane - 1].count;
-            lo = glm::min(lo, axisBins[plane - 1].lo);
-            hi = glm::max(hi, axisBins[plane - 1].hi);
-            if (count == 0 || rightCount[plane] == 0) continue;
+        for (int j = 1; j < used; ++j) {
+            count += axisBins[occupied[j - 1]].count;
+            side.extend(axisBins[occupied[j - 1]].bounds);
             float c = options.traversalCost + options.intersectionCost *
-                                                  (area(lo, hi) * float(count) +
-                                                   rightArea[plane] * float(rightCount[plane])) /
+                                                  (side.surfaceArea() * float(count) +
+                                                   rightArea[j] * float(rightCount[j])) /
                                                   nodeArea;
             if (c < cost) {
                 cost = c;
                 bestAxis = axis;
-                bestPlane = plane;
+                bestPlane = occupied[j];  // bins below this one go left
             }
         }
     }
     if (bestAxis < 0) return 0;
     // Partition with the same bin arithmetic, so every primitive lands where it was counted.
+    // Lomuto's scheme without a branch: each primitive is swapped to the end of the left
+    // part, which grows only when it goes left. (std::partition branches on every
+    // primitive and mispredicts often: this loop made the bunny's build 25% faster.)
     float axisLowest = lowest[bestAxis], axisScale = scale[bestAxis];
-    auto middle = std::partition(prims.begin(), prims.end(), [&](const BuildPrimitive& p) {
+    size_t left = 0;
+    for (BuildPrimitive& p : prims) {
         int b = std::min(bins - 1, int((component(p.centroid, bestAxis) - axisLowest) * axisScale));
-        return b < bestPlane;
-    });
-    return size_t(middle - prims.begin());
+        bool goesLeft = b < bestPlane;
+        std::swap(p, prims[left]);
+        left += goesLeft ? 1 : 0;
+    }
+    return left;
     // END SOLUTION
 }
 
@@ -201,17 +294,69 @@ size_t partitionSweepSah(std::span<BuildPrimitive> prims, const Bounds3f& nodeBo
     return bestLeft;
 }
 
+// The build's large arrays (the primitives, the nodes, the leaf triangles: some 30 MB for
+// the motorbike) are first touched during the build, one 4 KiB page fault each: a third
+// of a one-shot build's CPU time on this machine (perf: 29,000 faults for the motorbike).
+// Where Linux offers transparent huge pages on request ("madvise" mode), an array of a
+// megabyte or more is placed on 2 MiB boundaries and asks for 2 MiB pages: 512x fewer
+// faults, and fewer TLB misses when tracing.
+void* allocateLarge(size_t bytes) {
+    if (bytes < kHugePage / 2) return ::operator new(bytes, std::align_val_t(64));
+    size_t rounded = (bytes + kHugePage - 1) & ~(kHugePage - 1);
+    void* p = ::operator new(rounded, std::align_val_t(kHugePage));
+#if defined(__linux__) && defined(MADV_HUGEPAGE)
+    madvise(p, rounded, MADV_HUGEPAGE);  // advice only: a failure changes nothing
+#endif
+    return p;
+}
+
+void freeLarge(void* p, size_t bytes) {
+    ::operator delete(p, std::align_val_t(bytes < kHugePage / 2 ? 64 : kHugePage));
+}
+
 namespace {
+
+// An array the build fills once (the leaf triangles, the slot order): when it is large,
+// ask for transparent huge pages over the whole 2 MiB blocks of its reserved, not yet
+// touched capacity (see allocateLarge; without 2 MiB alignment the blocks at its ends
+// keep 4 KiB pages). Advice only: any failure changes nothing.
+template <typename Vector>
+void reserveOnHugePages(Vector& v, size_t capacity) {
+    v.reserve(capacity);
+#if defined(__linux__) && defined(MADV_HUGEPAGE)
+    uintptr_t begin = reinterpret_cast<uintptr_t>(v.data());
+    uintptr_t end = begin + v.capacity() * sizeof(*v.data());
+    begin = (begin + kHugePage - 1) & ~uintptr_t(kHugePage - 1);
+    end &= ~uintptr_t(kHugePage - 1);
+    if (end > begin) madvise(reinterpret_cast<void*>(begin), end - begin, MADV_HUGEPAGE);
+#endif
+}
+
+// The build's working array of primitives, on huge pages (allocateLarge).
+template <typename T>
+struct LargeArrayAllocator {
+    using value_type = T;
+    LargeArrayAllocator() = default;
+    template <typename U>
+    LargeArrayAllocator(const LargeArrayAllocator<U>&) {}
+    T* allocate(size_t n) { return static_cast<T*>(allocateLarge(n * sizeof(T))); }
+    void deallocate(T* p, size_t n) { freeLarge(p, n * sizeof(T)); }
+    template <typename U>
+    bool operator==(const LargeArrayAllocator<U>&) const {
+        return true;
+    }
+};
+using BuildPrimitives = std::vector<BuildPrimitive, LargeArrayAllocator<BuildPrimitive>>;
 
 class BvhBuildJob {
 public:
-    BvhBuildJob(std::vector<BuildPrimitive>& prims, const BvhBuildOptions& options, Bvh& bvh)
+    BvhBuildJob(BuildPrimitives& prims, const BvhBuildOptions& options, Bvh& bvh)
         : prims_(prims), options_(options), bvh_(bvh) {}
 
     void build() {
         bvh_.nodes.clear();
         if (prims_.empty()) return;
-        bvh_.nodes.reserve(2 * prims_.size());
+        bvh_.nodes.reserve(2 * prims_.size());  // on huge pages: see ChildPairAllocator
         bvh_.nodes.emplace_back();
         buildNode(0, 0, prims_.size(), 0);
     }
@@ -223,12 +368,12 @@ private:
     }
 
     void buildNode(uint32_t nodeIndex, size_t begin, size_t end, int depth) {
-        Bounds3f bounds, centroids;
+        PackedBounds packedBounds = PackedBounds::empty(), packedCentroids = PackedBounds::empty();
         for (size_t i = begin; i < end; ++i) {
-            bounds.extend(prims_[i].bounds.min);
-            bounds.extend(prims_[i].bounds.max);
-            centroids.extend(prims_[i].centroid);
+            packedBounds.extend(prims_[i]);
+            packedCentroids.extendByCentroid(prims_[i]);
         }
+        Bounds3f bounds = packedBounds.bounds(), centroids = packedCentroids.bounds();
         size_t n = end - begin;
         BvhNode& node = bvh_.nodes[nodeIndex];
         node.boundsMin = bounds.min;
@@ -278,7 +423,7 @@ private:
         buildNode(leftChild + 1, begin + left, end, depth + 1);
     }
 
-    std::vector<BuildPrimitive>& prims_;
+    BuildPrimitives& prims_;
     const BvhBuildOptions& options_;
     Bvh& bvh_;
 };
@@ -290,12 +435,12 @@ void checkOptions(const BvhBuildOptions& options) {
         throw InputError("BVH depth limit must be between 1 and 64");
 }
 
-Bvh buildFromPrimitives(std::vector<BuildPrimitive>& prims, const BvhBuildOptions& options) {
+Bvh buildFromPrimitives(BuildPrimitives& prims, const BvhBuildOptions& options) {
     checkOptions(options);
     Bvh bvh;
     BvhBuildJob(prims, options, bvh).build();
-    bvh.primitiveIndices.resize(prims.size());
-    for (size_t i = 0; i < prims.size(); ++i) bvh.primitiveIndices[i] = prims[i].index;
+    reserveOnHugePages(bvh.primitiveIndices, prims.size());
+    for (const BuildPrimitive& p : prims) bvh.primitiveIndices.push_back(p.index);
     return bvh;
 }
 
@@ -310,9 +455,10 @@ void finishStats(const Bvh& bvh, const BvhBuildOptions& options, double ms, BvhB
 Bvh buildBvh(std::span<const Bounds3f> primitiveBounds, const BvhBuildOptions& options,
              BvhBuildStats* stats) {
     Stopwatch watch;
-    std::vector<BuildPrimitive> prims(primitiveBounds.size());
-    for (size_t i = 0; i < prims.size(); ++i)
-        prims[i] = {primitiveBounds[i], primitiveBounds[i].centroid(), uint32_t(i)};
+    BuildPrimitives prims;
+    prims.reserve(primitiveBounds.size());
+    for (size_t i = 0; i < primitiveBounds.size(); ++i)
+        prims.push_back({primitiveBounds[i], primitiveBounds[i].centroid(), uint32_t(i)});
     Bvh bvh = buildFromPrimitives(prims, options);
     finishStats(bvh, options, watch.milliseconds(), stats);
     return bvh;
@@ -322,18 +468,17 @@ Bvh buildBvh(const Mesh& mesh, const BvhBuildOptions& options, BvhBuildStats* st
     if (mesh.triangles.size() >= size_t(0xFFFFFFF0u))
         throw InputError("mesh has too many triangles for 32-bit indices");
     Stopwatch watch;
-    std::vector<BuildPrimitive> prims(mesh.triangles.size());
-    for (size_t i = 0; i < prims.size(); ++i) {
+    BuildPrimitives prims;
+    prims.reserve(mesh.triangles.size());
+    for (size_t i = 0; i < mesh.triangles.size(); ++i) {
         Bounds3f b;
         for (int k = 0; k < 3; ++k) b.extend(mesh.vertex(i, k));
-        prims[i] = {b, b.centroid(), uint32_t(i)};
+        prims.push_back({b, b.centroid(), uint32_t(i)});
     }
     Bvh bvh = buildFromPrimitives(prims, options);
-    bvh.leafTriangles.resize(prims.size());
-    for (size_t s = 0; s < prims.size(); ++s) {
-        uint32_t t = bvh.primitiveIndices[s];
-        bvh.leafTriangles[s] = {mesh.vertex(t, 0), mesh.vertex(t, 1), mesh.vertex(t, 2)};
-    }
+    reserveOnHugePages(bvh.leafTriangles, prims.size());
+    for (uint32_t t : bvh.primitiveIndices)
+        bvh.leafTriangles.push_back({mesh.vertex(t, 0), mesh.vertex(t, 1), mesh.vertex(t, 2)});
     finishStats(bvh, options, watch.milliseconds(), stats);
     return bvh;
 }

@@ -1,5 +1,7 @@
 #include "04_bvh/measure.hpp"
 
+#include <thread>
+
 #include "01_triangle/measure.hpp"
 #include "04_bvh/bvh4.hpp"
 #include "core/timing.hpp"
@@ -19,6 +21,25 @@ double traceMrays(const Bvh& bvh, const std::vector<Ray>& rays, int repeats, int
     std::vector<TraceHit> hits;
     Timing t = measure(repeats, [&] { traceBatch(bvh, rays, hits, threads); });
     return double(rays.size()) / t.median / 1e6;
+}
+
+// The machine's own parallelism at the moment: a loop that touches no memory, split the
+// same way over 1 and 2 threads (millions of iterations per second). On two idle cores it
+// scales by 2; when it does not (cores shared with other work), neither can the tracer.
+double busyLoopMops(int threads, int repeats) {
+    constexpr long kIterations = 20'000'000;  // per thread
+    Timing t = measure(repeats, [&] {
+        std::vector<std::thread> pool;
+        for (int i = 0; i < threads; ++i)
+            pool.emplace_back([] {
+                float x = 0.0f;
+                for (long k = 0; k < kIterations; ++k) x = x * 0.999f + 1.0f;  // converges
+                volatile float sink = x;
+                (void)sink;
+            });
+        for (auto& thread : pool) thread.join();
+    });
+    return double(kIterations) * threads / t.median / 1e6;
 }
 
 }  // namespace
@@ -102,13 +123,17 @@ Table measureThreads(const NamedMesh& mesh, size_t rays, int repeats, uint64_t s
     t.title = "Threads: binned SAH on '" + mesh.name + "', 1 thread against 2";
     t.columns = {"rays", "1 thread Mrays/s", "2 threads Mrays/s", "speed-up"};
     t.note = "rays handed out in chunks of 1024 through an atomic counter; median of " +
-             std::to_string(repeats) + " runs; the machine has 2 cores shared with other work";
+             std::to_string(repeats) +
+             " runs; 'control': a loop that touches no memory, split the same way (millions of "
+             "iterations per second): the speed-up two threads can have on this machine now";
     Bvh bvh = buildBvh(*mesh.mesh, optionsFor(BvhBuilder::BinnedSah, 16));
     for (RayKind kind : {RayKind::Primary, RayKind::Diffuse}) {
         std::vector<Ray> set = makeRays(*mesh.mesh, kind, rays, seed);
         double one = traceMrays(bvh, set, repeats, 1), two = traceMrays(bvh, set, repeats, 2);
         t.row({std::string(rayKindName(kind)), one, two, two / one});
     }
+    double one = busyLoopMops(1, repeats), two = busyLoopMops(2, repeats);
+    t.row({std::string("control"), one, two, two / one});
     return t;
 }
 

@@ -130,19 +130,27 @@ bool referenceTriangle(const Ray& ray, const LeafTriangle& tri, double& t) {
     return t >= ray.tmin && t <= ray.tmax;
 }
 
-// Nearest through the hierarchy with the reference test; the slot's primitive or miss.
-uint32_t nearestWithReference(const Bvh& bvh, const Ray& ray, double& tBest) {
-    tBest = kInfinity<double>;
-    float tClosest = ray.tmax;
-    uint32_t slot = traverseNearest(bvh, TraversalRay(ray), tClosest, [&](uint32_t s, float& tmax) {
+// The reference test as a traversal's leaf test over `tree`'s leaf triangles: a hit in
+// [ray.tmin, tmax] nearer than tBest (double) lowers both.
+template <typename Tree>
+auto referenceLeafTest(const Tree& tree, const Ray& ray, double& tBest) {
+    return [&tree, &ray, &tBest](uint32_t s, float& tmax) {
         double t;
-        if (!referenceTriangle(ray, bvh.leafTriangles[s], t) || !(t <= double(tmax)) ||
+        if (!referenceTriangle(ray, tree.leafTriangles[s], t) || !(t <= double(tmax)) ||
             !(t < tBest))
             return false;
         tBest = t;
         tmax = float(t);
         return true;
-    });
+    };
+}
+
+// Nearest through the hierarchy with the reference test; the slot's primitive or miss.
+uint32_t nearestWithReference(const Bvh& bvh, const Ray& ray, double& tBest) {
+    tBest = kInfinity<double>;
+    float tClosest = ray.tmax;
+    uint32_t slot =
+        traverseNearest(bvh, TraversalRay(ray), tClosest, referenceLeafTest(bvh, ray, tBest));
     return slot == kTraversalMiss ? kNoPrimitive : bvh.primitiveIndices[slot];
 }
 
@@ -780,15 +788,7 @@ uint32_t nearest4WithReference(const Bvh4& wide, const Ray& ray, double& tBest) 
     tBest = kInfinity<double>;
     float tClosest = ray.tmax;
     uint32_t slot =
-        traverseNearest4(wide, TraversalRay(ray), tClosest, [&](uint32_t s, float& tmax) {
-            double t;
-            if (!referenceTriangle(ray, wide.leafTriangles[s], t) || !(t <= double(tmax)) ||
-                !(t < tBest))
-                return false;
-            tBest = t;
-            tmax = float(t);
-            return true;
-        });
+        traverseNearest4(wide, TraversalRay(ray), tClosest, referenceLeafTest(wide, ray, tBest));
     return slot == kTraversalMiss ? kNoPrimitive : wide.primitiveIndices[slot];
 }
 

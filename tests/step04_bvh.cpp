@@ -1115,6 +1115,24 @@ TEST_SUITE("bvh 4-wide") {
     }
 }
 
+namespace {
+
+// A HITS.bin the trace command wrote: one hit per ray, each agreeing with brute force.
+// Returns how many rays hit.
+size_t checkHitsFileAgainstBruteForce(const std::string& path, const Mesh& mesh,
+                                      const std::vector<Ray>& rays) {
+    std::vector<TraceHit> hits = readHits(path);
+    REQUIRE(hits.size() == rays.size());
+    size_t hitCount = 0;
+    for (size_t i = 0; i < rays.size(); ++i) {
+        CHECK(hitsAgree(hits[i], traceBruteForce(mesh, rays[i])));
+        hitCount += hits[i].triangle != kNoPrimitive;
+    }
+    return hitCount;
+}
+
+}  // namespace
+
 TEST_SUITE("program 04") {
     const std::string program = BOXES_PROGRAM;
 
@@ -1151,13 +1169,7 @@ TEST_SUITE("program 04") {
             for (const char* key : {"\"tris\":3290", "\"rays\":900", "\"build_ms\"", "\"trace_ms\"",
                                     "\"mrays_per_s\"", "\"hits\"", "\"threads\":1", "\"builder\""})
                 CHECK(run.out.find(key) != std::string::npos);
-            std::vector<TraceHit> hits = readHits(dir.file("hits.bin"));
-            REQUIRE(hits.size() == rays.size());
-            size_t hitCount = 0;
-            for (size_t i = 0; i < rays.size(); ++i) {
-                CHECK(hitsAgree(hits[i], traceBruteForce(sh1, rays[i])));
-                hitCount += hits[i].triangle != kNoPrimitive;
-            }
+            size_t hitCount = checkHitsFileAgainstBruteForce(dir.file("hits.bin"), sh1, rays);
             CHECK(hitCount > 100);
             CHECK(run.out.find("\"hits\":" + std::to_string(hitCount)) != std::string::npos);
         }
@@ -1175,14 +1187,7 @@ TEST_SUITE("program 04") {
         INFO(run.err);
         REQUIRE(run.exitCode == 0);
         CHECK(run.out.find("\"width\":4") != std::string::npos);
-        std::vector<TraceHit> hits = readHits(dir.file("hits.bin"));
-        REQUIRE(hits.size() == rays.size());
-        size_t hitCount = 0;
-        for (size_t i = 0; i < rays.size(); ++i) {
-            CHECK(hitsAgree(hits[i], traceBruteForce(sh1, rays[i])));
-            hitCount += hits[i].triangle != kNoPrimitive;
-        }
-        CHECK(hitCount > 100);
+        CHECK(checkHitsFileAgainstBruteForce(dir.file("hits.bin"), sh1, rays) > 100);
         auto bad = test::runProgram(program,
                                     "trace --mesh " + test::dataDir() +
                                         "/meshes/sh1.obj --rays rays.bin --hits h3.bin --width 3",

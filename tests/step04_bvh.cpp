@@ -112,6 +112,7 @@ std::vector<Bounds3f> triangleBounds(const Mesh& m) {
 BvhBuildOptions optionsFor(BvhBuilder builder) {
     BvhBuildOptions o;
     o.builder = builder;
+    o.intersectionCost = 1.0f;  // the hand-worked SAH costs below take both costs as 1
     return o;
 }
 
@@ -1187,6 +1188,9 @@ TEST_SUITE("program 04") {
         INFO(run.err);
         REQUIRE(run.exitCode == 0);
         CHECK(run.out.find("\"width\":4") != std::string::npos);
+        // The JSON names the traced tree's node count beside the binary one's.
+        Bvh4Stats wide = bvh4Stats(collapseToBvh4(buildBvh(sh1, BvhBuildOptions{})));
+        CHECK(run.out.find("\"nodes_4wide\":" + std::to_string(wide.nodes)) != std::string::npos);
         CHECK(checkHitsFileAgainstBruteForce(dir.file("hits.bin"), sh1, rays) > 100);
         auto bad = test::runProgram(program,
                                     "trace --mesh " + test::dataDir() +

@@ -101,9 +101,11 @@ struct BvhBuildOptions {
     int maxLeafSize = 16;  // SAH: a node may become a leaf (when cheaper) up to this size
     int maxDepth = 64;     // below this a node becomes a leaf, whatever its size
     // SAH constants: cost of a node visit and of a primitive test (Goldsmith & Salmon 1987,
-    // MacDonald & Booth 1990). Only their ratio matters for the tree.
+    // MacDonald & Booth 1990). Only their ratio matters for the tree. A node visit here
+    // tests two boxes and may wait for memory; one watertight triangle test from a leaf's
+    // contiguous slots costs about half of that (measured: step 04's README).
     float traversalCost = 1.0f;
-    float intersectionCost = 1.0f;
+    float intersectionCost = 0.5f;
 };
 
 // Per build: what the report prints for every hierarchy.
@@ -163,17 +165,26 @@ BvhBuildStats bvhStats(const Bvh& bvh, const BvhBuildOptions& options);
 // ---------------------------------------------------------------------------------------
 // Traversal.
 
+// 1 + 2 gamma(3), gamma(n) = n eps / (1 - n eps) with eps = 2^-24 (pbrt-v4, Ize 2013):
+// widening the slab test's far distance by it makes the float slab test itself
+// conservative (its own roundings never drop a box the exact ray touches). The ray folds it
+// into the far planes' 1/d once: (b - o) * (1/d * scale) has four roundings, like
+// (b - o) * 1/d * scale, and the same bound, with one product less per slab.
+constexpr float kBoxFarScale = 1.0f + 2.0f * (3.0f * 0x1p-24f) / (1.0f - 3.0f * 0x1p-24f);
+
 // A ray prepared for box tests: reciprocal direction (+infinity for a zero component),
 // and the origin moved by a margin, so the box test is conservative with respect to the
 // watertight triangle test. That test translates the vertices to the ray origin and shears
 // them, rounding each time: it can report a hit up to a few float steps of |vertex - O|
 // outside the exact triangle (Woop, Benthin, Wald 2013, section 4: the box test must
 // allow for the same error). We widen each box by
-//   margin = 64 * 2^-24 * (|O - centre| + radius)   (the root's bounding sphere),
+//   margin = 64 * 2^-24 * (|O - centre| + radius)   (the root's bounding sphere; taxicab
+//   lengths, see marginFor),
 // an upper bound of that error for every vertex in the tree, folded into two origins:
 // minimum planes use O + margin and maximum planes O - margin (same cost as one origin).
 struct TraversalRay {
     Vec3 originForMin, originForMax, direction, inverseDirection;
+    Vec3 farInverseDirection;  // inverseDirection * kBoxFarScale
     float tmin, tmax;
     // Per axis, which bound the ray meets first (offsets into a node seen as 8 floats:
     // min at 0..2, max at 4..6) and the origin that goes with it: no swap in the slab test.
@@ -194,6 +205,7 @@ struct TraversalRay {
             farOffset[axis] = positive ? 4 + axis : axis;
             nearOrigin[axis] = positive ? (&originForMin.x)[axis] : (&originForMax.x)[axis];
             farOrigin[axis] = positive ? (&originForMax.x)[axis] : (&originForMin.x)[axis];
+            (&farInverseDirection.x)[axis] = (&inverseDirection.x)[axis] * kBoxFarScale;
         }
     }
     // The margin for the triangles of `bvh` (see above).
@@ -207,34 +219,34 @@ struct TraversalRay {
     static float marginFor(const Ray& ray, const Bvh& bvh) {
         return bvh.empty() ? 0.0f : marginFor(ray, bvh.bounds());
     }
-    // In double: in float the squared lengths overflow for coordinates beyond about 1e19,
-    // and an infinite margin turns every slab distance into NaN (every box entered).
+    // In double: in float the sums overflow for coordinates beyond about 1e38, and an
+    // infinite margin turns every slab distance into NaN (every box entered). The lengths
+    // are taxicab lengths, an upper bound of the Euclidean ones (at most sqrt(3) times
+    // larger): a margin a little wider, no square root per ray.
     static float marginFor(const Ray& ray, const Bounds3f& rootBounds) {
         Vec3d lo(rootBounds.min), hi(rootBounds.max);
-        double radius = 0.5 * glm::length(hi - lo);
-        return float(64.0 * 0x1p-24 * (glm::length(Vec3d(ray.origin) - 0.5 * (lo + hi)) + radius));
+        Vec3d halfExtent = 0.5 * (hi - lo),
+              offset = glm::abs(Vec3d(ray.origin) - (lo + halfExtent));
+        double radius = halfExtent.x + halfExtent.y + halfExtent.z;
+        return float(64.0 * 0x1p-24 * (offset.x + offset.y + offset.z + radius));
     }
 };
-
-// 1 + 2 gamma(3), gamma(n) = n eps / (1 - n eps) with eps = 2^-24 (pbrt-v4, Ize 2013):
-// widening the slab test's far distance by it makes the float slab test itself
-// conservative (its own roundings never drop a box the exact ray touches).
-constexpr float kBoxFarScale = 1.0f + 2.0f * (3.0f * 0x1p-24f) / (1.0f - 3.0f * 0x1p-24f);
 
 // The conservative slab test against a node's box in [ray.tmin, tmax]; tEntry is where the
 // ray enters (>= ray.tmin). Not step 03's exercise: the hierarchy needs its own copy.
 // 0 * infinity (origin on a slab plane, zero direction component) gives NaN, and the
 // comparisons below ignore a NaN bound: the ray lies in that plane, and the closed box
 // contains it along that axis. Components through pointers: glm's operator[] is a switch.
-inline bool intersectNodeBounds(const BvhNode& node, const TraversalRay& ray, float tmax,
-                                float& tEntry) {
+[[gnu::always_inline]] inline bool intersectNodeBounds(const BvhNode& node, const TraversalRay& ray,
+                                                       float tmax, float& tEntry) {
     static_assert(offsetof(BvhNode, boundsMax) == 4 * sizeof(float), "node as 8 floats");
     const float* bounds = &node.boundsMin.x;
     const float* inv = &ray.inverseDirection.x;
+    const float* farInv = &ray.farInverseDirection.x;
     float t0 = ray.tmin, t1 = tmax;
     for (int axis = 0; axis < 3; ++axis) {
         float tNear = (bounds[ray.nearOffset[axis]] - ray.nearOrigin[axis]) * inv[axis];
-        float tFar = (bounds[ray.farOffset[axis]] - ray.farOrigin[axis]) * inv[axis] * kBoxFarScale;
+        float tFar = (bounds[ray.farOffset[axis]] - ray.farOrigin[axis]) * farInv[axis];
         t0 = tNear > t0 ? tNear : t0;  // a NaN bound is ignored (see above)
         t1 = tFar < t1 ? tFar : t1;
     }
@@ -244,6 +256,20 @@ inline bool intersectNodeBounds(const BvhNode& node, const TraversalRay& ray, fl
 
 // Depth of the traversal stack: the builders cap the depth below it.
 constexpr int kTraversalStackSize = 128;
+
+// Asks for what the traversal will read after `node` (its children's pair of boxes, or
+// its leaf's triangles) while the box tests of the current pair are still running:
+// incoherent rays spend most of their time waiting for memory, and the fetch overlaps.
+inline void prefetchNodeContents(const Bvh& bvh, const BvhNode& node) {
+    if (!node.isLeaf())
+        __builtin_prefetch(&bvh.nodes[node.leftFirst]);
+    else if (!bvh.leafTriangles.empty()) {
+        // A leaf's triangles (36 bytes each) span two cache lines from its second one on.
+        const char* first = reinterpret_cast<const char*>(&bvh.leafTriangles[node.leftFirst]);
+        __builtin_prefetch(first);
+        if (node.count > 1) __builtin_prefetch(first + 64);
+    }
+}
 
 // EXERCISE 4.4: nearest-hit traversal: nearer child first, early out (4 points)
 // intersect(slot, tClosest) tests the primitive in leaf slot `slot` for a hit in
@@ -258,6 +284,10 @@ uint32_t traverseNearest(const Bvh& bvh, const TraversalRay& ray, float& tCloses
     if (bvh.nodes.empty()) return kTraversalMiss;
     uint32_t nearestSlot = kTraversalMiss;
     const BvhNode* nodes = bvh.nodes.data();
+    // Local copies: the compiler may then keep them in registers across intersect(),
+    // which it must otherwise assume writes to them.
+    const TraversalRay r = ray;
+    float tBest = tClosest;
     // The stack keeps where the ray enters each postponed node: a pop skips it without a
     // second box test once a hit nearer than that is known.
     struct Entry {
@@ -266,19 +296,21 @@ uint32_t traverseNearest(const Bvh& bvh, const TraversalRay& ray, float& tCloses
     } stack[kTraversalStackSize];
     int stackSize = 0;
     float tRoot;
-    if (!intersectNodeBounds(nodes[0], ray, tClosest, tRoot)) return kTraversalMiss;
+    if (!intersectNodeBounds(nodes[0], r, tBest, tRoot)) return kTraversalMiss;
     uint32_t current = 0;
     for (;;) {
         const BvhNode& node = nodes[current];
         if (node.isLeaf()) {
             for (uint32_t slot = node.leftFirst; slot < node.leftFirst + node.count; ++slot)
-                if (intersect(slot, tClosest)) nearestSlot = slot;
+                if (intersect(slot, tBest)) nearestSlot = slot;
         } else {
             // Both children at once: descend into the nearer, keep the farther for later.
             uint32_t near = node.leftFirst, far = node.leftFirst + 1;
+            prefetchNodeContents(bvh, nodes[near]);
+            prefetchNodeContents(bvh, nodes[far]);
             float tNear, tFar;
-            bool hitNear = intersectNodeBounds(nodes[near], ray, tClosest, tNear);
-            bool hitFar = intersectNodeBounds(nodes[far], ray, tClosest, tFar);
+            bool hitNear = intersectNodeBounds(nodes[near], r, tBest, tNear);
+            bool hitFar = intersectNodeBounds(nodes[far], r, tBest, tFar);
             if (hitNear && hitFar) {
                 if (tFar < tNear) {
                     std::swap(near, far);
@@ -297,7 +329,7 @@ uint32_t traverseNearest(const Bvh& bvh, const TraversalRay& ray, float& tCloses
         bool found = false;
         while (stackSize > 0) {
             const Entry& e = stack[--stackSize];
-            if (e.tEntry <= tClosest) {
+            if (e.tEntry <= tBest) {
                 current = e.node;
                 found = true;
                 break;
@@ -305,6 +337,7 @@ uint32_t traverseNearest(const Bvh& bvh, const TraversalRay& ray, float& tCloses
         }
         if (!found) break;
     }
+    tClosest = tBest;
     return nearestSlot;
     // END SOLUTION
 }

@@ -84,9 +84,9 @@ Bvh4Stats bvh4Stats(const Bvh4& bvh);
 // plane array met first and of the one met last, and broadcast origins and 1/d.
 struct Bvh4Ray {
     int nearOffset[3], farOffset[3];
-    float nearOrigin[3], farOrigin[3], inverseDirection[3], tmin;
+    float nearOrigin[3], farOrigin[3], inverseDirection[3], farInverseDirection[3], tmin;
 #if defined(__SSE2__)
-    __m128 nearOriginV[3], farOriginV[3], inverseDirectionV[3], tminV;
+    __m128 nearOriginV[3], farOriginV[3], inverseDirectionV[3], farInverseDirectionV[3], tminV;
 #endif
     explicit Bvh4Ray(const TraversalRay& ray) : tmin(ray.tmin) {
         for (int axis = 0; axis < 3; ++axis) {
@@ -96,10 +96,12 @@ struct Bvh4Ray {
             nearOrigin[axis] = ray.nearOrigin[axis];
             farOrigin[axis] = ray.farOrigin[axis];
             inverseDirection[axis] = (&ray.inverseDirection.x)[axis];
+            farInverseDirection[axis] = (&ray.farInverseDirection.x)[axis];
 #if defined(__SSE2__)
             nearOriginV[axis] = _mm_set1_ps(nearOrigin[axis]);
             farOriginV[axis] = _mm_set1_ps(farOrigin[axis]);
             inverseDirectionV[axis] = _mm_set1_ps(inverseDirection[axis]);
+            farInverseDirectionV[axis] = _mm_set1_ps(farInverseDirection[axis]);
 #endif
         }
 #if defined(__SSE2__)
@@ -116,15 +118,13 @@ inline int intersectChildBounds(const Bvh4Node& node, const Bvh4Ray& ray, float 
     const float* planes = &node.boundsMin[0][0];
 #if defined(__SSE2__)
     __m128 t0 = ray.tminV, t1 = _mm_set1_ps(tmax);
-    const __m128 farScale = _mm_set1_ps(kBoxFarScale);
     for (int axis = 0; axis < 3; ++axis) {
         __m128 tNear = _mm_mul_ps(
             _mm_sub_ps(_mm_load_ps(planes + ray.nearOffset[axis]), ray.nearOriginV[axis]),
             ray.inverseDirectionV[axis]);
-        __m128 tFar = _mm_mul_ps(
+        __m128 tFar =
             _mm_mul_ps(_mm_sub_ps(_mm_load_ps(planes + ray.farOffset[axis]), ray.farOriginV[axis]),
-                       ray.inverseDirectionV[axis]),
-            farScale);
+                       ray.farInverseDirectionV[axis]);
         // maxps/minps return the second operand when either is NaN: the running bound
         // goes second, so a NaN plane distance is ignored (as `tNear > t0 ? tNear : t0`).
         t0 = _mm_max_ps(tNear, t0);
@@ -143,7 +143,7 @@ inline int intersectChildBounds(const Bvh4Node& node, const Bvh4Ray& ray, float 
             float tNear = (planes[ray.nearOffset[axis] + i] - ray.nearOrigin[axis]) *
                           ray.inverseDirection[axis];
             float tFar = (planes[ray.farOffset[axis] + i] - ray.farOrigin[axis]) *
-                         ray.inverseDirection[axis] * kBoxFarScale;
+                         ray.farInverseDirection[axis];
             t0 = tNear > t0 ? tNear : t0;
             t1 = tFar < t1 ? tFar : t1;
         }
@@ -406,8 +406,19 @@ inline uint32_t intersectLeafPackets(Axes axes, const WatertightRay& r, const Wa
     return nearest;
 }
 
+// Does the ray enter the root box? (Decided before the triangle test's per-ray set-up.)
+inline bool entersRoot(const Bvh4& bvh, const TraversalRay& traversal) {
+    if (bvh.empty()) return false;
+    BvhNode root;
+    root.boundsMin = bvh.rootBounds.min;
+    root.boundsMax = bvh.rootBounds.max;
+    float tEntry;
+    return intersectNodeBounds(root, traversal, traversal.tmax, tEntry);
+}
+
 inline TraceHit traceNearest(const Bvh4& bvh, const Ray& ray) {
     TraversalRay traversal(ray, traversalMargin(ray, bvh));
+    if (!entersRoot(bvh, traversal)) return {};
     WatertightRay watertight(ray);
     WatertightRay4 watertight4(watertight);
     float tClosest = ray.tmax;
@@ -423,6 +434,7 @@ inline TraceHit traceNearest(const Bvh4& bvh, const Ray& ray) {
 
 inline bool traceOccluded(const Bvh4& bvh, const Ray& ray) {
     TraversalRay traversal(ray, traversalMargin(ray, bvh));
+    if (!entersRoot(bvh, traversal)) return false;
     WatertightRay watertight(ray);
     WatertightRay4 watertight4(watertight);
     return withWatertightAxes(watertight, [&](auto axes) {

@@ -158,8 +158,16 @@ struct TraceHit {
 };
 static_assert(sizeof(TraceHit) == 8, "the HITS.bin record");
 
+inline bool entersRoot(const Bvh& bvh, const TraversalRay& traversal) {
+    float tEntry;
+    return !bvh.empty() && intersectNodeBounds(bvh.nodes[0], traversal, traversal.tmax, tEntry);
+}
+
 inline TraceHit traceNearest(const Bvh& bvh, const Ray& ray) {
     TraversalRay traversal(ray, bvh);
+    // Most rays of a camera framing a mesh miss its root box: decide that before the
+    // triangle test's per-ray set-up (three divisions) and the dispatch on its axes.
+    if (!entersRoot(bvh, traversal)) return {};
     WatertightRay watertight(ray);
     float tClosest = ray.tmax;
     const LeafTriangle* tris = bvh.leafTriangles.data();
@@ -174,6 +182,7 @@ inline TraceHit traceNearest(const Bvh& bvh, const Ray& ray) {
 
 inline bool traceOccluded(const Bvh& bvh, const Ray& ray) {
     TraversalRay traversal(ray, bvh);
+    if (!entersRoot(bvh, traversal)) return false;
     WatertightRay watertight(ray);
     const LeafTriangle* tris = bvh.leafTriangles.data();
     return withWatertightAxes(watertight, [&](auto axes) {

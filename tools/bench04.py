@@ -22,6 +22,7 @@ import json
 import os
 import resource
 import shutil
+import statistics
 import struct
 import subprocess
 import sys
@@ -98,15 +99,12 @@ def measure_threads(a, peer, obj, mesh, kind, work):
                 [peer, obj, rays, hits, "--threads", str(n), "--repeat",
                  str(a.repeat)])["mrays_per_s"])
 
-    def median(xs):
-        xs = sorted(xs)
-        return xs[len(xs) // 2] if len(xs) % 2 else 0.5 * (xs[len(xs) // 2 - 1] + xs[len(xs) // 2])
-
     def speedup(who):
-        return median([b / o for o, b in zip(speed[who][1], speed[who][2])])
+        return statistics.median([b / o for o, b in zip(speed[who][1], speed[who][2])])
 
-    t = {"mesh": mesh, "kind": kind, "rays": a.thread_rays, "one": median(speed["ours"][1]),
-         "two": median(speed["ours"][2]), "speedup": speedup("ours"),
+    t = {"mesh": mesh, "kind": kind, "rays": a.thread_rays,
+         "one": statistics.median(speed["ours"][1]), "two": statistics.median(speed["ours"][2]),
+         "speedup": speedup("ours"),
          "embree_speedup": speedup("embree")}
     print("%-9s %-8s threads: ours 1: %.3f  2: %.3f Mrays/s  speed-up %.2fx (Embree's %.2fx)"
           % (mesh, kind, t["one"], t["two"], t["speedup"], t["embree_speedup"]), file=sys.stderr)

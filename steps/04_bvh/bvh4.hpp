@@ -406,16 +406,6 @@ inline uint32_t intersectLeafPackets(Axes axes, const WatertightRay& r, const Wa
     return nearest;
 }
 
-// Does the ray enter the root box? (Decided before the triangle test's per-ray set-up.)
-inline bool entersRoot(const Bvh4& bvh, const TraversalRay& traversal) {
-    if (bvh.empty()) return false;
-    BvhNode root;
-    root.boundsMin = bvh.rootBounds.min;
-    root.boundsMax = bvh.rootBounds.max;
-    float tEntry;
-    return intersectNodeBounds(root, traversal, traversal.tmax, tEntry);
-}
-
 inline TraceHit traceNearest(const Bvh4& bvh, const Ray& ray) {
     TraversalRay traversal(ray, traversalMargin(ray, bvh));
     if (!entersRoot(bvh, traversal)) return {};

@@ -158,9 +158,16 @@ struct TraceHit {
 };
 static_assert(sizeof(TraceHit) == 8, "the HITS.bin record");
 
-inline bool entersRoot(const Bvh& bvh, const TraversalRay& traversal) {
+// Does the ray enter the tree's root box (a Bvh or a Bvh4: anything with empty() and
+// bounds())? The tracers decide that before the triangle test's per-ray set-up.
+template <typename Tree>
+bool entersRoot(const Tree& tree, const TraversalRay& traversal) {
+    if (tree.empty()) return false;
+    BvhNode root;
+    root.boundsMin = tree.bounds().min;
+    root.boundsMax = tree.bounds().max;
     float tEntry;
-    return !bvh.empty() && intersectNodeBounds(bvh.nodes[0], traversal, traversal.tmax, tEntry);
+    return intersectNodeBounds(root, traversal, traversal.tmax, tEntry);
 }
 
 inline TraceHit traceNearest(const Bvh& bvh, const Ray& ray) {

@@ -122,8 +122,11 @@ inline bool intersectLeafTriangle(Axes, const WatertightRay& r, const LeafTriang
     float det = u + v + w;  // not finite exactly when an edge function overflowed
     if (!std::isfinite(det)) [[unlikely]]
         return intersectLeafTriangleDouble(Axes{}, r, tri, tmax, uOut, vOut);
-    if ((u < 0.0f || v < 0.0f || w < 0.0f) && (u > 0.0f || v > 0.0f || w > 0.0f)) return false;
-    if (det == 0.0f) return false;
+    // Bitwise | and & on the comparisons: one branch, mostly taken (most tests miss),
+    // instead of a chain of unpredictable ones.
+    bool negative = (u < 0.0f) | (v < 0.0f) | (w < 0.0f);
+    bool positive = (u > 0.0f) | (v > 0.0f) | (w > 0.0f);
+    if ((negative & positive) | (det == 0.0f)) return false;
     float az = r.sz * a[kz], bz = r.sz * b[kz], cz = r.sz * c[kz];
     float tScaled = u * az + v * bz + w * cz;
     // Outside the normal range the products may have underflowed to zeros whose signs no

@@ -202,7 +202,21 @@ uint32_t traverseNearest4Leaves(const Bvh4& bvh, const TraversalRay& traversal, 
                     count = node.count[first];
                     continue;
                 }
-                // Two to four: sorted farthest first onto the stack, the nearest descended.
+                int second = std::countr_zero(unsigned(mask));
+                mask &= mask - 1;
+                if (mask == 0) {  // two children: no sort loop, the order by a select
+                    // On a tie the later child first, as the sort below would.
+                    bool secondFirst = t[second] <= t[first];
+                    int nearer = secondFirst ? second : first,
+                        farther = secondFirst ? first : second;
+                    stack[stackSize++] = {node.child[farther], node.count[farther], t[farther]};
+                    prefetchChild(bvh, node.child[farther], node.count[farther]);
+                    child = node.child[nearer];
+                    count = node.count[nearer];
+                    continue;
+                }
+                mask |= 1 << second;
+                // Three or four: sorted farthest first onto the stack, the nearest descended.
                 Entry hit[4];
                 hit[0] = {node.child[first], node.count[first], t[first]};
                 int hits = 1;

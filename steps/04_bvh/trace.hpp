@@ -164,7 +164,7 @@ static_assert(sizeof(TraceHit) == 8, "the HITS.bin record");
 // Does the ray enter the tree's root box (a Bvh or a Bvh4: anything with empty() and
 // bounds())? The tracers decide that before the triangle test's per-ray set-up.
 template <typename Tree>
-bool entersRoot(const Tree& tree, const TraversalRay& traversal) {
+[[gnu::always_inline]] inline bool entersRoot(const Tree& tree, const TraversalRay& traversal) {
     if (tree.empty()) return false;
     BvhNode root;
     root.boundsMin = tree.bounds().min;

@@ -225,10 +225,12 @@ struct TraversalRay {
     // larger): a margin a little wider, no square root per ray.
     static float marginFor(const Ray& ray, const Bounds3f& rootBounds) {
         Vec3d lo(rootBounds.min), hi(rootBounds.max);
-        Vec3d halfExtent = 0.5 * (hi - lo),
-              offset = glm::abs(Vec3d(ray.origin) - (lo + halfExtent));
+        Vec3d halfExtent = 0.5 * (hi - lo), offset = Vec3d(ray.origin) - (lo + halfExtent);
         double radius = halfExtent.x + halfExtent.y + halfExtent.z;
-        return float(64.0 * 0x1p-24 * (offset.x + offset.y + offset.z + radius));
+        // std::fabs, not glm::abs: GCC compiles the latter to compares and branches, which
+        // incoherent rays mispredict.
+        double distance = std::fabs(offset.x) + std::fabs(offset.y) + std::fabs(offset.z);
+        return float(64.0 * 0x1p-24 * (distance + radius));
     }
 };
 

@@ -1,7 +1,7 @@
 #!/usr/bin/python3
 """Step 04 beside Intel Embree: the same rays, back to back, one thread each.
 
-usage: tools/bench04.py [--rays N] [--repeat K] [--meshes bunny,motorbike,oa_thor]
+usage: tools/bench04.py [--rays N] [--repeat K] [--rounds R] [--meshes bunny,motorbike,oa_thor]
                         [--kinds primary,diffuse,random] [--builders midpoint,median,sah,sah4]
                         [--no-extras] [--thread-rays N] [--thread-pairs P]
                         [--out out/04_bvh_bench.json] [--data DIR] [--program PATH]
@@ -9,8 +9,9 @@ usage: tools/bench04.py [--rays N] [--repeat K] [--meshes bunny,motorbike,oa_tho
 For every mesh and ray kind (primary, diffuse, random) it writes one ray set with
 peer-bench's make_rays.py, runs peer-bench (Embree 3, one thread) and then our
 `04_bvh trace` with each builder on that file (and "sah 4-wide": the binned SAH tree
-collapsed to 4-wide nodes, `--width 4`), each --repeat times (the programs report
-the median), and compares the hits ray by ray with Embree's. The interior map (oa_thor)
+collapsed to 4-wide nodes, `--width 4`), each run --repeat passes (the programs report
+the median), all of it --rounds times, alternating; the ratios are the medians of the
+rounds' own ratios. It compares the hits ray by ray with Embree's. The interior map (oa_thor)
 gets its primary rays from the inside camera of the meshes README. Also: binned SAH on
 2 threads against 1 beside Embree's own two-thread speed-up (larger ray sets, alternating
 pairs), and the full-sweep SAH cost (the quality reference). Prints the
@@ -114,7 +115,9 @@ def measure_threads(a, peer, obj, mesh, kind, work):
 def main():
     ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     ap.add_argument("--rays", type=int, default=250000)
-    ap.add_argument("--repeat", type=int, default=5)
+    ap.add_argument("--repeat", type=int, default=5, help="trace passes per run (its median)")
+    ap.add_argument("--rounds", type=int, default=3,
+                    help="runs of Embree and every builder, alternating (medians of the ratios)")
     ap.add_argument("--meshes", default="bunny,motorbike,oa_thor")
     ap.add_argument("--kinds", default="primary,diffuse,random")
     ap.add_argument("--builders", default="midpoint,median,sah,sah4",
@@ -146,29 +149,49 @@ def main():
             extra = INSIDE if (mesh == "oa_thor" and kind == "primary") else []
             subprocess.run(["/usr/bin/python3", os.path.join(peer_src, "make_rays.py"), obj, kind,
                             str(a.rays), rays] + extra, check=True, capture_output=True)
-            ehits = os.path.join(work, "embree.bin")
-            emb = run_embree([peer, obj, rays, ehits, "--threads", "1"], a.repeat)
-            eh = read_hits(ehits)
-            # "sah 4-wide": the binned SAH tree collapsed to 4-wide nodes, SIMD traversal.
-            for builder, args in (("midpoint", ["--builder", "midpoint"]),
-                                  ("median", ["--builder", "median"]),
-                                  ("sah", ["--builder", "sah"]),
-                                  ("sah 4-wide", ["--builder", "sah", "--width", "4"])):
-                if (builder.replace(" 4-wide", "4")) not in a.builders.split(","):
-                    continue
-                ohits = os.path.join(work, "ours.bin")
-                ours = run_ours([a.program, "trace", "--mesh", obj, "--rays", rays, "--hits",
-                                  ohits, "--threads", "1"] + args, a.repeat)
+            # Rounds: Embree, then every builder, again and again; each ratio is the median
+            # of the rounds' own ratios, so a burst of load on this shared machine spoils
+            # one round, not the comparison (a single run drifts by 10-20%).
+            variants = [(b, args) for b, args in (
+                ("midpoint", ["--builder", "midpoint"]), ("median", ["--builder", "median"]),
+                ("sah", ["--builder", "sah"]),
+                # "sah 4-wide": the binned SAH tree collapsed to 4-wide nodes, SIMD traversal.
+                ("sah 4-wide", ["--builder", "sah", "--width", "4"]))
+                if b.replace(" 4-wide", "4") in a.builders.split(",")]
+            ehits, ohits = os.path.join(work, "embree.bin"), os.path.join(work, "ours.bin")
+            embree_runs, our_runs, agree = [], {b: [] for b, _ in variants}, {}
+            for round_index in range(a.rounds):
+                embree_runs.append(run_embree([peer, obj, rays, ehits, "--threads", "1"],
+                                              a.repeat))
+                eh = read_hits(ehits) if round_index == 0 else None
+                for builder, args in variants:
+                    our_runs[builder].append(run_ours(
+                        [a.program, "trace", "--mesh", obj, "--rays", rays, "--hits", ohits,
+                         "--threads", "1"] + args, a.repeat))
+                    if eh is not None:
+                        agree[builder] = agreement(read_hits(ohits), eh)
+            for builder, _ in variants:
+                runs = our_runs[builder]
+
+                def med(key, of=runs):
+                    return statistics.median(r[key] for r in of)
+
                 row = {"mesh": mesh, "kind": kind, "builder": builder,
-                       "mrays_per_s": ours["mrays_per_s"], "embree_mrays_per_s": emb["mrays_per_s"],
-                       "ratio": ours["mrays_per_s"] / emb["mrays_per_s"],
-                       "cpu_mrays_per_s": ours["mrays_per_cpu_s"],
-                       "embree_cpu_mrays_per_s": emb["mrays_per_cpu_s"],
-                       "cpu_ratio": ours["mrays_per_cpu_s"] / emb["mrays_per_cpu_s"],
-                       "build_cpu_ms": ours.get("build_cpu_ms", 0.0),
-                       "build_ms": ours["build_ms"], "embree_build_ms": emb["build_ms"],
-                       "sah_cost": ours["sah_cost"], "tris": ours["tris"], "rays": ours["rays"],
-                       "agree_with_embree": agreement(read_hits(ohits), eh)}
+                       "mrays_per_s": med("mrays_per_s"),
+                       "embree_mrays_per_s": med("mrays_per_s", embree_runs),
+                       "ratio": statistics.median(
+                           o["mrays_per_s"] / e["mrays_per_s"] for o, e in zip(runs, embree_runs)),
+                       "cpu_mrays_per_s": med("mrays_per_cpu_s"),
+                       "embree_cpu_mrays_per_s": med("mrays_per_cpu_s", embree_runs),
+                       "cpu_ratio": statistics.median(
+                           o["mrays_per_cpu_s"] / e["mrays_per_cpu_s"]
+                           for o, e in zip(runs, embree_runs)),
+                       "build_cpu_ms": med("build_cpu_ms"), "build_ms": med("build_ms"),
+                       "embree_build_ms": med("build_ms", embree_runs),
+                       "sah_cost": runs[0]["sah_cost"], "tris": runs[0]["tris"],
+                       "rays": runs[0]["rays"], "agree_with_embree": agree[builder],
+                       "round_mrays_per_s": [r["mrays_per_s"] for r in runs],
+                       "round_cpu_mrays_per_s": [r["mrays_per_cpu_s"] for r in runs]}
                 rows.append(row)
                 print("%-9s %-8s %-10s %7.3f Mrays/s  x%.2f Embree (CPU time: x%.2f)  build %8.1f ms"
                       "  SAH %.2f  agree %.4f" % (mesh, kind, builder, row["mrays_per_s"],
@@ -191,22 +214,25 @@ def main():
                                 "s_per_mtri": sah["build_ms"] / 1e3 / (sah["tris"] / 1e6),
                                 "cpu_s_per_mtri": sah["build_cpu_ms"] / 1e3 / (sah["tris"] / 1e6)})
 
-    print("\nStep 04 beside Embree 3 (one thread each, medians of %d runs, %d rays per set)"
-          % (a.repeat, a.rays))
+    print("\nStep 04 beside Embree 3 (one thread each, %d rays per set; %d rounds of Embree "
+          "and each builder, each run the median of %d passes; Mrays/s the median of the "
+          "rounds, ratio the median of the rounds' ratios)" % (a.rays, a.rounds, a.repeat))
     print("%-10s %-8s %-10s %9s %9s %7s %9s %10s %9s %8s" % ("mesh", "rays", "builder", "Mrays/s",
           "Embree", "ratio", "CPU ratio", "build ms", "SAH cost", "agree"))
     for r in rows:
         print("%-10s %-8s %-10s %9.3f %9.3f %7.3f %9.3f %10.1f %9.2f %8.4f" % (
             r["mesh"], r["kind"], r["builder"], r["mrays_per_s"], r["embree_mrays_per_s"],
             r["ratio"], r["cpu_ratio"], r["build_ms"], r["sah_cost"], r["agree_with_embree"]))
-    print("\nBinned SAH against midpoint (primary rays; wall, CPU time):")
+    def paired(a_row, b_row, key):  # the median of the rounds' own ratios
+        return statistics.median(x / y for x, y in zip(a_row["round_" + key], b_row["round_" + key]))
+
+    print("\nBinned SAH against midpoint (primary rays; wall, CPU time; medians of the rounds):")
     for mesh in a.meshes.split(","):
         by = {r["builder"]: r for r in rows if r["mesh"] == mesh and r["kind"] == "primary"}
         if "sah" not in by or "midpoint" not in by:
             continue
-        print("  %-10s %.2fx  %.2fx" % (
-            mesh, by["sah"]["mrays_per_s"] / by["midpoint"]["mrays_per_s"],
-            by["sah"]["cpu_mrays_per_s"] / by["midpoint"]["cpu_mrays_per_s"]))
+        print("  %-10s %.2fx  %.2fx" % (mesh, paired(by["sah"], by["midpoint"], "mrays_per_s"),
+                                        paired(by["sah"], by["midpoint"], "cpu_mrays_per_s")))
     print("\n4-wide (SIMD) against the binary tree, binned SAH (wall, CPU time):")
     for mesh in a.meshes.split(","):
         for kind in a.kinds.split(","):
@@ -214,8 +240,8 @@ def main():
             if "sah" not in by or "sah 4-wide" not in by:
                 continue
             print("  %-10s %-8s %.2fx  %.2fx" % (
-                mesh, kind, by["sah 4-wide"]["mrays_per_s"] / by["sah"]["mrays_per_s"],
-                by["sah 4-wide"]["cpu_mrays_per_s"] / by["sah"]["cpu_mrays_per_s"]))
+                mesh, kind, paired(by["sah 4-wide"], by["sah"], "mrays_per_s"),
+                paired(by["sah 4-wide"], by["sah"], "cpu_mrays_per_s")))
     print("\nBuild and quality (binned SAH, 16 bins, one thread):")
     for q in quality:
         print("  %-10s %8d tris  %7.1f ms  %.3f s/Mtri (CPU %.3f)  SAH %.2f vs sweep %.2f "
@@ -247,11 +273,13 @@ def main():
                    "rows": [[r["mesh"], r["kind"], r["builder"], r["mrays_per_s"],
                              r["embree_mrays_per_s"], r["ratio"], r["cpu_ratio"], r["build_ms"],
                              r["sah_cost"], r["agree_with_embree"]] for r in rows],
-                   "note": "medians of %d runs each, back to back on the same ray file; 'ratio' "
+                   "note": "%d rounds of Embree then each builder on the same ray file, each "
+                           "run the median of %d passes; Mrays/s the median of the rounds; "
+                           "'ratio' (the median of the rounds' ratios) "
                            "from wall times, 'CPU ratio' from the CPU seconds of a trace pass "
                            "(ours: measured in the program; Embree: runs with --repeat 1 and 1+P, "
                            "the difference over P (about 2 s of passes); steadier on a loaded machine); 'agree': share of rays with Embree's triangle or t"
-                           % a.repeat},
+                           % (a.rounds, a.repeat)},
                   {"id": "bench04_build", "title": "Binned SAH build: time and quality",
                    "columns": ["mesh", "tris", "build ms", "s/Mtri", "CPU s/Mtri", "SAH cost",
                                "sweep SAH cost", "excess %"],

@@ -193,11 +193,16 @@ def main():
                        "round_mrays_per_s": [r["mrays_per_s"] for r in runs],
                        "round_cpu_mrays_per_s": [r["mrays_per_cpu_s"] for r in runs]}
                 rows.append(row)
-                print("%-9s %-8s %-10s %7.3f Mrays/s  x%.2f Embree (CPU time: x%.2f)  build %8.1f ms"
-                      "  SAH %.2f  agree %.4f" % (mesh, kind, builder, row["mrays_per_s"],
-                                                  row["ratio"], row["cpu_ratio"], row["build_ms"],
-                                                  row["sah_cost"], row["agree_with_embree"]),
-                      file=sys.stderr)
+                # The rounds' own ratios, lowest to highest: a wide range says the machine
+                # was noisy while this row ran (trust the median less).
+                ratios = sorted(o["mrays_per_s"] / e["mrays_per_s"]
+                                for o, e in zip(runs, embree_runs))
+                row["ratio_range"] = [ratios[0], ratios[-1]]
+                print("%-9s %-8s %-10s %7.3f Mrays/s  x%.2f Embree (rounds %.2f-%.2f; CPU time: "
+                      "x%.2f)  build %8.1f ms  SAH %.2f  agree %.4f"
+                      % (mesh, kind, builder, row["mrays_per_s"], row["ratio"], ratios[0],
+                         ratios[-1], row["cpu_ratio"], row["build_ms"], row["sah_cost"],
+                         row["agree_with_embree"]), file=sys.stderr)
             if kind in ("primary", "diffuse") and not a.no_extras:
                 threads.append(measure_threads(a, peer, obj, mesh, kind, work))
             if sweep is None and not a.no_extras:
@@ -217,12 +222,14 @@ def main():
     print("\nStep 04 beside Embree 3 (one thread each, %d rays per set; %d rounds of Embree "
           "and each builder, each run the median of %d passes; Mrays/s the median of the "
           "rounds, ratio the median of the rounds' ratios)" % (a.rays, a.rounds, a.repeat))
-    print("%-10s %-8s %-10s %9s %9s %7s %9s %10s %9s %8s" % ("mesh", "rays", "builder", "Mrays/s",
-          "Embree", "ratio", "CPU ratio", "build ms", "SAH cost", "agree"))
+    print("%-10s %-8s %-10s %9s %9s %7s %11s %9s %10s %9s %8s" % (
+        "mesh", "rays", "builder", "Mrays/s", "Embree", "ratio", "rounds", "CPU ratio", "build ms",
+        "SAH cost", "agree"))
     for r in rows:
-        print("%-10s %-8s %-10s %9.3f %9.3f %7.3f %9.3f %10.1f %9.2f %8.4f" % (
+        print("%-10s %-8s %-10s %9.3f %9.3f %7.3f %5.2f-%5.2f %9.3f %10.1f %9.2f %8.4f" % (
             r["mesh"], r["kind"], r["builder"], r["mrays_per_s"], r["embree_mrays_per_s"],
-            r["ratio"], r["cpu_ratio"], r["build_ms"], r["sah_cost"], r["agree_with_embree"]))
+            r["ratio"], r["ratio_range"][0], r["ratio_range"][1], r["cpu_ratio"], r["build_ms"],
+            r["sah_cost"], r["agree_with_embree"]))
     def paired(a_row, b_row, key):  # the median of the rounds' own ratios
         return statistics.median(x / y for x, y in zip(a_row["round_" + key], b_row["round_" + key]))
 

@@ -53,6 +53,18 @@ struct LeafTriangle {
 constexpr size_t kHugePage = size_t(2) << 20;
 void* allocateLarge(size_t bytes);
 void freeLarge(void* p, size_t bytes);
+// Asks for transparent huge pages over the whole 2 MiB blocks inside [data, data + bytes).
+// Advice only: any failure changes nothing.
+void adviseHugePages(const void* data, size_t bytes);
+
+// An array a build fills once (leaf triangles, slot order, a 4-wide tree's arrays): when it
+// is large, its reserved, not yet touched capacity goes on huge pages (without 2 MiB
+// alignment the blocks at its ends keep 4 KiB pages).
+template <typename Vector>
+void reserveOnHugePages(Vector& v, size_t capacity) {
+    v.reserve(capacity);
+    adviseHugePages(v.data(), v.capacity() * sizeof(*v.data()));
+}
 
 // The node array's allocator: it places node 0 (the root, which has no sibling) in the
 // second half of a 64-byte cache line, so every pair of children (1, 2), (3, 4), ...

@@ -314,23 +314,18 @@ void freeLarge(void* p, size_t bytes) {
     ::operator delete(p, std::align_val_t(bytes < kHugePage / 2 ? 64 : kHugePage));
 }
 
-namespace {
-
-// An array the build fills once (the leaf triangles, the slot order): when it is large,
-// ask for transparent huge pages over the whole 2 MiB blocks of its reserved, not yet
-// touched capacity (see allocateLarge; without 2 MiB alignment the blocks at its ends
-// keep 4 KiB pages). Advice only: any failure changes nothing.
-template <typename Vector>
-void reserveOnHugePages(Vector& v, size_t capacity) {
-    v.reserve(capacity);
+void adviseHugePages(const void* data, size_t bytes) {
 #if defined(__linux__) && defined(MADV_HUGEPAGE)
-    uintptr_t begin = reinterpret_cast<uintptr_t>(v.data());
-    uintptr_t end = begin + v.capacity() * sizeof(*v.data());
+    uintptr_t begin = reinterpret_cast<uintptr_t>(data), end = begin + bytes;
     begin = (begin + kHugePage - 1) & ~uintptr_t(kHugePage - 1);
     end &= ~uintptr_t(kHugePage - 1);
     if (end > begin) madvise(reinterpret_cast<void*>(begin), end - begin, MADV_HUGEPAGE);
+#else
+    (void)data, (void)bytes;
 #endif
 }
+
+namespace {
 
 // The build's working array of primitives, on huge pages (allocateLarge).
 template <typename T>

@@ -69,6 +69,11 @@ def run_ours(cmd, repeat):
     return j
 
 
+def round_ratios(ours, theirs, key):
+    """Per round, ours[key] / theirs[key], lowest first (ours and theirs: one run per round)."""
+    return sorted(o[key] / t[key] for o, t in zip(ours, theirs))
+
+
 def read_hits(path):
     data = open(path, "rb").read()
     return [struct.unpack_from("<fI", data, 8 * i) for i in range(len(data) // 8)]
@@ -176,28 +181,23 @@ def main():
                 def med(key, of=runs):
                     return statistics.median(r[key] for r in of)
 
+                # The rounds' own ratios; a wide range says the machine was noisy while this
+                # row ran (trust the median less).
+                ratios = round_ratios(runs, embree_runs, "mrays_per_s")
                 row = {"mesh": mesh, "kind": kind, "builder": builder,
                        "mrays_per_s": med("mrays_per_s"),
                        "embree_mrays_per_s": med("mrays_per_s", embree_runs),
-                       "ratio": statistics.median(
-                           o["mrays_per_s"] / e["mrays_per_s"] for o, e in zip(runs, embree_runs)),
+                       "ratio": statistics.median(ratios), "ratio_range": [ratios[0], ratios[-1]],
                        "cpu_mrays_per_s": med("mrays_per_cpu_s"),
                        "embree_cpu_mrays_per_s": med("mrays_per_cpu_s", embree_runs),
                        "cpu_ratio": statistics.median(
-                           o["mrays_per_cpu_s"] / e["mrays_per_cpu_s"]
-                           for o, e in zip(runs, embree_runs)),
+                           round_ratios(runs, embree_runs, "mrays_per_cpu_s")),
                        "build_cpu_ms": med("build_cpu_ms"), "build_ms": med("build_ms"),
                        "embree_build_ms": med("build_ms", embree_runs),
                        "sah_cost": runs[0]["sah_cost"], "tris": runs[0]["tris"],
                        "rays": runs[0]["rays"], "agree_with_embree": agree[builder],
-                       "round_mrays_per_s": [r["mrays_per_s"] for r in runs],
-                       "round_cpu_mrays_per_s": [r["mrays_per_cpu_s"] for r in runs]}
+                       "runs": runs}
                 rows.append(row)
-                # The rounds' own ratios, lowest to highest: a wide range says the machine
-                # was noisy while this row ran (trust the median less).
-                ratios = sorted(o["mrays_per_s"] / e["mrays_per_s"]
-                                for o, e in zip(runs, embree_runs))
-                row["ratio_range"] = [ratios[0], ratios[-1]]
                 print("%-9s %-8s %-10s %7.3f Mrays/s  x%.2f Embree (rounds %.2f-%.2f; CPU time: "
                       "x%.2f)  build %8.1f ms  SAH %.2f  agree %.4f"
                       % (mesh, kind, builder, row["mrays_per_s"], row["ratio"], ratios[0],
@@ -230,8 +230,9 @@ def main():
             r["mesh"], r["kind"], r["builder"], r["mrays_per_s"], r["embree_mrays_per_s"],
             r["ratio"], r["ratio_range"][0], r["ratio_range"][1], r["cpu_ratio"], r["build_ms"],
             r["sah_cost"], r["agree_with_embree"]))
-    def paired(a_row, b_row, key):  # the median of the rounds' own ratios
-        return statistics.median(x / y for x, y in zip(a_row["round_" + key], b_row["round_" + key]))
+
+    def paired(a_row, b_row, key):  # two builders: the median of the rounds' own ratios
+        return statistics.median(round_ratios(a_row["runs"], b_row["runs"], key))
 
     print("\nBinned SAH against midpoint (primary rays; wall, CPU time; medians of the rounds):")
     for mesh in a.meshes.split(","):
@@ -239,7 +240,7 @@ def main():
         if "sah" not in by or "midpoint" not in by:
             continue
         print("  %-10s %.2fx  %.2fx" % (mesh, paired(by["sah"], by["midpoint"], "mrays_per_s"),
-                                        paired(by["sah"], by["midpoint"], "cpu_mrays_per_s")))
+                                        paired(by["sah"], by["midpoint"], "mrays_per_cpu_s")))
     print("\n4-wide (SIMD) against the binary tree, binned SAH (wall, CPU time):")
     for mesh in a.meshes.split(","):
         for kind in a.kinds.split(","):
@@ -248,7 +249,7 @@ def main():
                 continue
             print("  %-10s %-8s %.2fx  %.2fx" % (
                 mesh, kind, paired(by["sah 4-wide"], by["sah"], "mrays_per_s"),
-                paired(by["sah 4-wide"], by["sah"], "cpu_mrays_per_s")))
+                paired(by["sah 4-wide"], by["sah"], "mrays_per_cpu_s")))
     print("\nBuild and quality (binned SAH, 16 bins, one thread):")
     for q in quality:
         print("  %-10s %8d tris  %7.1f ms  %.3f s/Mtri (CPU %.3f)  SAH %.2f vs sweep %.2f "

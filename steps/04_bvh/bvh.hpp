@@ -98,6 +98,7 @@ struct Bvh {
 
     bool empty() const { return nodes.empty(); }
     Bounds3f bounds() const { return empty() ? Bounds3f() : nodes[0].bounds(); }
+    const BvhNode& rootNode() const { return nodes[0]; }  // not when empty
 };
 
 enum class BvhBuilder { Midpoint, Median, BinnedSah, SweepSah };

@@ -122,7 +122,8 @@ struct Collapser {
 Bvh4 collapseToBvh4(const Bvh& binary) {
     Bvh4 wide;
     if (binary.empty()) return wide;
-    wide.rootBounds = binary.bounds();
+    wide.root.boundsMin = binary.nodes[0].boundsMin;
+    wide.root.boundsMax = binary.nodes[0].boundsMax;
     Collapser collapser{binary, wide, std::vector<Collapser::SlotRange>(binary.nodes.size())};
     collapser.computeRanges(0);
     // Reserved for leaves padded to whole packets (more only makes a vector grow), on huge

@@ -63,10 +63,11 @@ struct Bvh4 {
     std::vector<uint32_t> primitiveIndices;   // slot -> primitive
     std::vector<LeafTriangle> leafTriangles;  // meshes only: slot -> vertices
     std::vector<TrianglePacket4> packets;     // meshes only: the same by four
-    Bounds3f rootBounds;
+    BvhNode root;  // the whole tree's box, as a binary node for the tracers' first test
 
     bool empty() const { return nodes.empty(); }
-    Bounds3f bounds() const { return rootBounds; }
+    Bounds3f bounds() const { return root.bounds(); }
+    const BvhNode& rootNode() const { return root; }
 };
 
 // Collapses a binary hierarchy: its leaves are kept, and so is any subtree of at most

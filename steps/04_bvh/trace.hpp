@@ -162,15 +162,15 @@ struct TraceHit {
 static_assert(sizeof(TraceHit) == 8, "the HITS.bin record");
 
 // Does the ray enter the tree's root box (a Bvh or a Bvh4: anything with empty() and
-// bounds())? The tracers decide that before the triangle test's per-ray set-up.
+// rootNode())? The tracers decide that before the triangle test's per-ray set-up. The
+// root is read where it lies: from a copy built here on the stack, the loads through
+// the ray's run-time plane offsets waited on the copy's stores (4-wide primary rays on
+// the bunny ran 1.07x faster without it).
 template <typename Tree>
 [[gnu::always_inline]] inline bool entersRoot(const Tree& tree, const TraversalRay& traversal) {
     if (tree.empty()) return false;
-    BvhNode root;
-    root.boundsMin = tree.bounds().min;
-    root.boundsMax = tree.bounds().max;
     float tEntry;
-    return intersectNodeBounds(root, traversal, traversal.tmax, tEntry);
+    return intersectNodeBounds(tree.rootNode(), traversal, traversal.tmax, tEntry);
 }
 
 inline TraceHit traceNearest(const Bvh& bvh, const Ray& ray) {

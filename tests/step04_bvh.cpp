@@ -4,6 +4,8 @@
 #include <doctest/doctest.h>
 
 #include <algorithm>
+#include <cstdlib>
+#include <cstring>
 #include <random>
 #include <set>
 
@@ -785,6 +787,23 @@ void checkStructure4(const Bvh4& wide, size_t primitives) {
     for (int n : seen) REQUIRE(n == 1);
 }
 
+// Rays from `distance` away towards triangles' centres (the camera of makeRays needs
+// squared lengths, which overflow for meshes near 1e20).
+std::vector<Ray> raysAtTriangles(const Mesh& m, size_t count, float distance, uint64_t seed) {
+    std::mt19937_64 rng(seed);
+    std::uniform_real_distribution<float> unit(-1.0f, 1.0f);
+    std::vector<Ray> rays;
+    for (size_t i = 0; i < count; ++i) {
+        size_t tri = size_t(rng() % m.triangleCount());
+        Vec3 target = (m.vertex(tri, 0) + m.vertex(tri, 1) + m.vertex(tri, 2)) / 3.0f;
+        Vec3 offset(unit(rng), unit(rng), unit(rng));
+        if (glm::length(offset) < 0.1f) offset = Vec3(0.0f, 0.0f, 1.0f);
+        Vec3 origin = target + glm::normalize(offset) * distance;
+        rays.emplace_back(origin, target - origin);
+    }
+    return rays;
+}
+
 uint32_t nearest4WithReference(const Bvh4& wide, const Ray& ray, double& tBest) {
     tBest = kInfinity<double>;
     float tClosest = ray.tmax;
@@ -1113,6 +1132,39 @@ TEST_SUITE("bvh 4-wide") {
         TraceHit h = traceNearest(wideTree(big), Ray(Vec3(0.0f), Vec3(0.0f, 0.0f, -1.0f)));
         CHECK(h.triangle == 0u);
         CHECK(h.t == doctest::Approx(5e20).epsilon(1e-6));
+    }
+    TEST_CASE("batch tracing: the AVX2 loop and the baseline loop give the same bits") {
+        // traceBatch runs a copy of the loop compiled for AVX2 where the CPU has it; the
+        // arithmetic is the same, so must be every hit, on ordinary rays and on far-away
+        // geometry where the leaf test falls back to double.
+        test::FpTrapsOff overflowOnPurpose;
+        Mesh bunny = loadObj(test::dataDir() + "/meshes/bunny.obj");
+        Mesh far = triangleSoup(3000, 42, 0.01f);
+        for (Vec3& p : far.positions) p = p * 1e20f + Vec3(3e20f, -1e20f, 0.0f);
+        MESSAGE("this CPU runs the AVX2 loop: " << (traceUsesAvx2() ? "yes" : "no"));
+        for (const Mesh* m : {&bunny, &far}) {
+            Bvh binary = buildBvh(*m, BvhBuildOptions{});
+            Bvh4 wide = collapseToBvh4(binary);
+            for (RayKind kind : {RayKind::Primary, RayKind::Diffuse, RayKind::Random}) {
+                INFO(rayKindName(kind) << (m == &far ? " rays, far mesh" : " rays, bunny"));
+                std::vector<Ray> rays = m == &far ? raysAtTriangles(far, 3000, 5e20f, int(kind))
+                                                  : makeRays(*m, kind, 3000, 43);
+                std::vector<TraceHit> fast2, fast4, base2, base4;
+                traceBatch(binary, rays, fast2, 1);
+                traceBatch(wide, rays, fast4, 1);
+                setenv("BOXES_NO_AVX2", "1", 1);
+                CHECK_FALSE(traceUsesAvx2());
+                traceBatch(binary, rays, base2, 1);
+                traceBatch(wide, rays, base4, 1);
+                unsetenv("BOXES_NO_AVX2");
+                size_t hits = 0;
+                for (const TraceHit& h : base2) hits += h.triangle != kNoPrimitive;
+                CHECK(hits > 100);
+                CHECK(std::memcmp(fast2.data(), base2.data(), rays.size() * sizeof(TraceHit)) == 0);
+                CHECK(std::memcmp(fast4.data(), base4.data(), rays.size() * sizeof(TraceHit)) == 0);
+                CHECK(std::memcmp(fast2.data(), fast4.data(), rays.size() * sizeof(TraceHit)) == 0);
+            }
+        }
     }
 }
 

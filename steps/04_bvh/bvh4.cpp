@@ -170,11 +170,29 @@ Bvh4Stats bvh4Stats(const Bvh4& bvh) {
     return s;
 }
 
+namespace {
+
+void traceRange(const Bvh4& bvh, const Ray* rays, TraceHit* hits, size_t begin, size_t end) {
+    for (size_t i = begin; i < end; ++i) hits[i] = traceNearest(bvh, rays[i]);
+}
+#if defined(BOXES_TARGET_AVX2)
+BOXES_TARGET_AVX2 void traceRangeAvx2(const Bvh4& bvh, const Ray* rays, TraceHit* hits,
+                                      size_t begin, size_t end) {
+    traceRange(bvh, rays, hits, begin, end);
+}
+#endif
+
+}  // namespace
+
 void traceBatch(const Bvh4& bvh, const std::vector<Ray>& rays, std::vector<TraceHit>& hits,
                 int threads) {
     hits.resize(rays.size());
+    auto range = &traceRange;
+#if defined(BOXES_TARGET_AVX2)
+    if (traceUsesAvx2()) range = &traceRangeAvx2;
+#endif
     forEachRayChunk(rays.size(), threads, [&](size_t begin, size_t end) {
-        for (size_t i = begin; i < end; ++i) hits[i] = traceNearest(bvh, rays[i]);
+        range(bvh, rays.data(), hits.data(), begin, end);
     });
 }
 

@@ -76,6 +76,7 @@ int runTrace(const TraceOptions& o) {
                         {"threads", o.threads},
                         {"builder", bvhBuilderName(build.builder)},
                         {"width", o.width},
+                        {"isa", traceUsesAvx2() ? "avx2" : "baseline"},
                         {"bins", o.bins},
                         {"repeat", o.repeat},
                         {"nodes", stats.nodes},

@@ -239,6 +239,18 @@ void traceBatchBruteForce(const Mesh& mesh, const std::vector<Ray>& rays,
 // `threads` threads (0: all cores). For other tracers of the step (the 4-wide one).
 void forEachRayChunk(size_t count, int threads, const std::function<void(size_t, size_t)>& f);
 
+// The batch tracers' inner loop is compiled twice: for baseline x86-64 and, with every
+// call inlined into it (gnu::flatten), for AVX2, chosen at run time as Embree chooses its
+// instruction set. The arithmetic is the same (AVX2 brings no FMA, and -ffp-contract=off
+// forbids contraction anyway), so are the bits of every hit; the AVX encoding's
+// three-operand instructions save the register copies of the SSE one.
+#if defined(__x86_64__) && defined(__GNUC__)
+#define BOXES_TARGET_AVX2 [[gnu::target("avx2"), gnu::flatten]]
+#endif
+// True when the batch tracers run their AVX2 loop: the CPU has AVX2 and the environment
+// does not set BOXES_NO_AVX2 (to measure or test the baseline loop). Read per batch.
+bool traceUsesAvx2();
+
 // Does a hierarchy's hit agree with brute force: the same triangle, or the same t (two
 // triangles sharing the hit point)?
 inline bool hitsAgree(const TraceHit& a, const TraceHit& b) {

@@ -34,13 +34,15 @@ Mesh tinyMesh() {
 struct Fixture {
     Mesh mesh = tinyMesh();
     Bvh sah, midpoint;
-    Bvh4 wide;  // the 4-wide SSE tree collapsed from the SAH tree
+    Bvh4 wide;   // the 4-wide SSE tree collapsed from the SAH tree
+    Bvh8 wide8;  // and the 8-wide one
     std::string hitsPath;
     Fixture() {
         BvhBuildOptions options;
         options.maxLeafSize = 2;
         sah = buildBvh(mesh, options);
         wide = collapseToBvh4(sah);
+        wide8 = collapseToBvh8(sah);
         options.builder = BvhBuilder::Midpoint;
         options.leafSize = 1;
         midpoint = buildBvh(mesh, options);
@@ -97,11 +99,12 @@ extern "C" int LLVMFuzzerTestOneInput(const uint8_t* data, size_t size) {
     if (rays.size() > 64 || !fixture()) return 0;  // tracing: small files only, to be fast
 
     Fixture& f = *fixture();
-    std::vector<TraceHit> reference, sah, midpoint, wide;
+    std::vector<TraceHit> reference, sah, midpoint, wide, wide8;
     traceBatchBruteForce(f.mesh, rays, reference, 1);
     traceBatch(f.sah, rays, sah, 1);
     traceBatch(f.midpoint, rays, midpoint, 1);
     traceBatch(f.wide, rays, wide, 1);
+    traceBatch(f.wide8, rays, wide8, 1);
     for (size_t i = 0; i < rays.size(); ++i) {
         // Every ray, however far its origin: the leaf test's double fallbacks and the box
         // margin (it grows with the distance) keep the hierarchy equal to brute force.
@@ -110,8 +113,19 @@ extern "C" int LLVMFuzzerTestOneInput(const uint8_t* data, size_t size) {
         checkHit(rays[i], sah[i], want, f.mesh.triangleCount(), "SAH hierarchy");
         checkHit(rays[i], midpoint[i], want, f.mesh.triangleCount(), "midpoint hierarchy");
         checkHit(rays[i], wide[i], want, f.mesh.triangleCount(), "4-wide hierarchy");
+        checkHit(rays[i], wide8[i], want, f.mesh.triangleCount(), "8-wide hierarchy");
+        // traceBatch runs its AVX2 loop where the CPU has it; traceNearest is the baseline
+        // code: the same bits.
+        TraceHit baseSah = traceNearest(f.sah, rays[i]), baseWide = traceNearest(f.wide, rays[i]),
+                 baseWide8 = traceNearest(f.wide8, rays[i]);
+        if (std::memcmp(&baseSah, &sah[i], sizeof(TraceHit)) != 0 ||
+            std::memcmp(&baseWide, &wide[i], sizeof(TraceHit)) != 0 ||
+            std::memcmp(&baseWide8, &wide8[i], sizeof(TraceHit)) != 0)
+            fuzz::fail("the batch loop and traceNearest differ");
         if (traceOccluded(f.wide, rays[i]) != (want.triangle != kNoPrimitive))
             fuzz::fail("4-wide occlusion disagrees with the nearest hit");
+        if (traceOccluded(f.wide8, rays[i]) != (want.triangle != kNoPrimitive))
+            fuzz::fail("8-wide occlusion disagrees with the nearest hit");
         if (traceOccluded(f.sah, rays[i]) != (want.triangle != kNoPrimitive))
             fuzz::fail("occlusion disagrees with the nearest hit");
     }

@@ -738,13 +738,15 @@ TEST_SUITE("trace 04") {
 // trace command is covered by "program 04".
 namespace {
 
-Bvh4 wideTree(const Mesh& m, BvhBuilder builder = BvhBuilder::SweepSah) {
-    return collapseToBvh4(buildBvh(m, optionsFor(builder)));
+template <int W = 4>
+BvhWide<W> wideTree(const Mesh& m, BvhBuilder builder = BvhBuilder::SweepSah) {
+    return collapseToWide<W>(buildBvh(m, optionsFor(builder)));
 }
 
 // Every primitive in exactly one leaf child, leaves starting a packet of four slots, every
 // inner child's box the union of its node's children, empty slots after the filled ones.
-void checkStructure4(const Bvh4& wide, size_t primitives) {
+template <int W>
+void checkStructure4(const BvhWide<W>& wide, size_t primitives) {
     REQUIRE_FALSE(wide.empty());
     REQUIRE(wide.primitiveIndices.size() % 4 == 0);
     std::vector<int> seen(primitives, 0);
@@ -755,10 +757,10 @@ void checkStructure4(const Bvh4& wide, size_t primitives) {
         stack.pop_back();
         ++reached;
         REQUIRE(index < wide.nodes.size());
-        const Bvh4Node& node = wide.nodes[index];
+        const BvhWideNode<W>& node = wide.nodes[index];
         Bounds3f unionOfChildren;
         bool emptySeen = false;
-        for (int i = 0; i < 4; ++i) {
+        for (int i = 0; i < W; ++i) {
             if (node.isEmpty(i)) {
                 emptySeen = true;
                 continue;
@@ -804,7 +806,8 @@ std::vector<Ray> raysAtTriangles(const Mesh& m, size_t count, float distance, ui
     return rays;
 }
 
-uint32_t nearest4WithReference(const Bvh4& wide, const Ray& ray, double& tBest) {
+template <int W>
+uint32_t nearest4WithReference(const BvhWide<W>& wide, const Ray& ray, double& tBest) {
     tBest = kInfinity<double>;
     float tClosest = ray.tmax;
     uint32_t slot =
@@ -813,7 +816,9 @@ uint32_t nearest4WithReference(const Bvh4& wide, const Ray& ray, double& tBest) 
 }
 
 // A mesh's rays of every kind against brute force, nearest and any hit; returns the hits.
-size_t checkAgainstBruteForce(const Mesh& m, const Bvh4& wide, size_t raysPerKind, uint64_t seed) {
+template <int W>
+size_t checkAgainstBruteForce(const Mesh& m, const BvhWide<W>& wide, size_t raysPerKind,
+                              uint64_t seed) {
     size_t hits = 0;
     for (RayKind kind : {RayKind::Primary, RayKind::Diffuse, RayKind::Random}) {
         INFO(rayKindName(kind));
@@ -851,7 +856,24 @@ TEST_SUITE("bvh 4-wide") {
         CHECK(wide.bounds() == binary.bounds());
         CHECK(reinterpret_cast<uintptr_t>(wide.nodes.data()) % 64 == 0);
     }
-    TEST_CASE("4-wide: the four-box test equals the scalar slab test bit for bit") {
+    TEST_CASE("8-wide: the collapse keeps every slot once in fewer, shallower nodes than 4-wide") {
+        Mesh m = triangleSoup(3000, 30);
+        Bvh binary = buildBvh(m, optionsFor(BvhBuilder::SweepSah));
+        Bvh4 wide4 = collapseToBvh4(binary);
+        Bvh8 wide8 = collapseToBvh8(binary);
+        checkStructure4(wide8, m.triangleCount());
+        BvhWideStats s4 = bvhWideStats(wide4), s8 = bvhWideStats(wide8);
+        // Leaves are kept or merged, never split; eight children per node instead of four
+        // take a third fewer nodes and levels.
+        CHECK(s8.leaves <= bvhStats(binary, optionsFor(BvhBuilder::SweepSah)).leaves);
+        CHECK(s8.nodes < s4.nodes * 2 / 3);
+        CHECK(s8.depth < s4.depth);
+        CHECK(double(s8.emptySlots) < 0.25 * double(8 * s8.nodes));
+        CHECK(wide8.bounds() == binary.bounds());
+        CHECK(reinterpret_cast<uintptr_t>(wide8.nodes.data()) % 64 == 0);
+    }
+    template <int W>
+    void boxTestCase() {
         // Random boxes and rays, with zero direction components and origins on box planes
         // (NaN from 0 * infinity) among them.
         test::FpTrapsOff nanOnPurpose;
@@ -860,9 +882,9 @@ TEST_SUITE("bvh 4-wide") {
         std::uniform_int_distribution<int> pick(0, 3);
         size_t entered = 0;
         for (int round = 0; round < 2000; ++round) {
-            Bvh4Node node{};
-            BvhNode boxes[4];
-            for (int i = 0; i < 4; ++i) {
+            BvhWideNode<W> node{};
+            BvhNode boxes[W];
+            for (int i = 0; i < W; ++i) {
                 Vec3 a(u(rng), u(rng), u(rng)), b(u(rng), u(rng), u(rng));
                 Bounds3f box(glm::min(a, b), glm::max(a, b));
                 if (pick(rng) == 0) box.max.y = box.min.y;  // a flat box
@@ -882,9 +904,20 @@ TEST_SUITE("bvh 4-wide") {
             float margin = pick(rng) == 0 ? 1e-3f : 0.0f;
             TraversalRay traversal(ray, margin);
             float tmax = pick(rng) == 0 ? 1.5f : kInfinity<float>;
-            float t4[4];
-            int mask = intersectChildBounds(node, Bvh4Ray(traversal), tmax, t4);
-            for (int i = 0; i < 4; ++i) {
+            alignas(32) float t4[W];
+            int mask = intersectChildBounds(node, WideRay<W>(traversal), tmax, t4);
+#if defined(BOXES_TARGET_AVX2)
+            // The AVX version of the 8-box test (the AVX2 batch loop's): the same bits.
+            if constexpr (W == 8) {
+                if (traceUsesAvx2()) {
+                    alignas(32) float tAvx[8];
+                    CHECK(intersectChildBoundsAvx(node, WideRay<8>(traversal), tmax, tAvx) == mask);
+                    for (int i = 0; i < 8; ++i)
+                        if (mask >> i & 1) CHECK(tAvx[i] == t4[i]);
+                }
+            }
+#endif
+            for (int i = 0; i < W; ++i) {
                 float t;
                 bool hit = intersectNodeBounds(boxes[i], traversal, tmax, t);
                 CHECK(bool(mask >> i & 1) == hit);
@@ -894,23 +927,31 @@ TEST_SUITE("bvh 4-wide") {
         }
         CHECK(entered > 300);
     }
-    TEST_CASE("hard case: 4-wide ray lying in a slab plane") {
+    TEST_CASE("4-wide: the four-box test equals the scalar slab test bit for bit") {
+        boxTestCase<4>();
+    }
+    TEST_CASE("8-wide: the eight-box test equals the scalar slab test bit for bit") {
+        boxTestCase<8>();
+    }
+    template <int W>
+    void slabPlaneCase() {
         // The ray runs in the plane y = 0 of the box [0, 1]^3 (origin on the plane, d.y = 0:
         // (0 - 0) * infinity = NaN) and must enter it at x = 0; the same ray at y = -0.5 misses.
         test::FpTrapsOff nanOnPurpose;
-        Bvh4Node node{};
-        for (int i = 0; i < 4; ++i)
+        BvhWideNode<W> node{};
+        for (int i = 0; i < W; ++i)
             for (int axis = 0; axis < 3; ++axis) {
                 node.boundsMin[axis][i] = i == 0 ? 0.0f : kInfinity<float>;
                 node.boundsMax[axis][i] = i == 0 ? 1.0f : -kInfinity<float>;
             }
         for (Vec3 dir : {Vec3(1.0f, 0.0f, 0.0f), Vec3(1.0f, -0.0f, 0.0f)}) {
-            float t[4];
+            alignas(32) float t[W];
             int mask = intersectChildBounds(
-                node, Bvh4Ray(TraversalRay(Ray(Vec3(-1, 0, 0.5f), dir))), kInfinity<float>, t);
+                node, WideRay<W>(TraversalRay(Ray(Vec3(-1, 0, 0.5f), dir))), kInfinity<float>, t);
             CHECK(mask == 1);  // the box, and no empty slot
             CHECK(t[0] == 1.0f);
-            CHECK(intersectChildBounds(node, Bvh4Ray(TraversalRay(Ray(Vec3(-1, -0.5f, 0.5f), dir))),
+            CHECK(intersectChildBounds(node,
+                                       WideRay<W>(TraversalRay(Ray(Vec3(-1, -0.5f, 0.5f), dir))),
                                        kInfinity<float>, t) == 0);
         }
         // Through a mesh: triangles on the planes x = 0, 2, 4, 6; rays along +x with origins
@@ -922,7 +963,7 @@ TEST_SUITE("bvh 4-wide") {
             m.positions.insert(m.positions.end(), {Vec3(x, 0, 0), Vec3(x, 1, 0), Vec3(x, 0, 1)});
             m.triangles.push_back({base, base + 1, base + 2});
         }
-        Bvh4 wide = wideTree(m);
+        BvhWide<W> wide = wideTree<W>(m);
         for (float y : {0.0f, 0.25f})
             for (Vec3 dir : {Vec3(1.0f, 0.0f, 0.0f), Vec3(1.0f, -0.0f, -0.0f)}) {
                 Ray ray(Vec3(-1.0f, y, 0.25f), dir);
@@ -931,6 +972,12 @@ TEST_SUITE("bvh 4-wide") {
                 CHECK(t == 1.0);
                 CHECK(traceNearest(wide, ray) == TraceHit{1.0f, 0u});
             }
+    }
+    TEST_CASE("hard case: 4-wide ray lying in a slab plane") {
+        slabPlaneCase<4>();
+    }
+    TEST_CASE("hard case: 8-wide ray lying in a slab plane") {
+        slabPlaneCase<8>();
     }
     TEST_CASE("4-wide: the four-triangle leaf test equals the scalar test bit for bit") {
         // One leaf of 7 triangles (two packets, the last lane a repeat): large overlapping
@@ -984,10 +1031,11 @@ TEST_SUITE("bvh 4-wide") {
         }
         CHECK(hits > 150);
     }
-    TEST_CASE("4-wide: nearest hit equals brute force on a triangle soup") {
+    template <int W>
+    void soupCase() {
         Mesh m = triangleSoup(2000, 32);
         Bvh binary = buildBvh(m, optionsFor(BvhBuilder::SweepSah));
-        Bvh4 wide = collapseToBvh4(binary);
+        BvhWide<W> wide = collapseToWide<W>(binary);
         size_t hits = 0;
         for (const Ray& ray : randomRays(2000, 33)) {
             double tTree, tBrute;
@@ -1002,9 +1050,16 @@ TEST_SUITE("bvh 4-wide") {
         }
         CHECK(hits > 200);
     }
-    TEST_CASE("4-wide: any hit agrees with brute force on shadow rays") {
+    TEST_CASE("4-wide: nearest hit equals brute force on a triangle soup") {
+        soupCase<4>();
+    }
+    TEST_CASE("8-wide: nearest hit equals brute force on a triangle soup") {
+        soupCase<8>();
+    }
+    template <int W>
+    void shadowCase() {
         Mesh m = triangleSoup(1500, 34);
-        Bvh4 wide = wideTree(m);
+        BvhWide<W> wide = wideTree<W>(m);
         size_t blocked = 0;
         std::mt19937_64 rng(35);
         std::uniform_real_distribution<float> len(0.05f, 1.0f);
@@ -1016,17 +1071,31 @@ TEST_SUITE("bvh 4-wide") {
         }
         CHECK(blocked > 100);
     }
-    TEST_CASE("4-wide: nearest and any hit equal brute force on real meshes") {
-        Mesh sh1 = loadObj(test::dataDir() + "/meshes/sh1.obj");
-        CHECK(checkAgainstBruteForce(sh1, wideTree(sh1), 400, 37) > 100);
-        Mesh bunny = loadObj(test::dataDir() + "/meshes/bunny.obj");
-        CHECK(checkAgainstBruteForce(bunny, wideTree(bunny), 100, 38) > 30);
+    TEST_CASE("4-wide: any hit agrees with brute force on shadow rays") {
+        shadowCase<4>();
     }
-    TEST_CASE("4-wide: no cracks at shared edges and vertices") {
+    TEST_CASE("8-wide: any hit agrees with brute force on shadow rays") {
+        shadowCase<8>();
+    }
+    template <int W>
+    void realMeshCase() {
+        Mesh sh1 = loadObj(test::dataDir() + "/meshes/sh1.obj");
+        CHECK(checkAgainstBruteForce(sh1, wideTree<W>(sh1), 400, 37) > 100);
+        Mesh bunny = loadObj(test::dataDir() + "/meshes/bunny.obj");
+        CHECK(checkAgainstBruteForce(bunny, wideTree<W>(bunny), 100, 38) > 30);
+    }
+    TEST_CASE("4-wide: nearest and any hit equal brute force on real meshes") {
+        realMeshCase<4>();
+    }
+    TEST_CASE("8-wide: nearest and any hit equal brute force on real meshes") {
+        realMeshCase<8>();
+    }
+    template <int W>
+    void cracksCase() {
         for (const char* name : {"sh1", "bunny"}) {
             INFO(name);
             Mesh m = loadObj(test::dataDir() + "/meshes/" + name + ".obj");
-            Bvh4 wide = wideTree(m);
+            BvhWide<W> wide = wideTree<W>(m);
             CrackRaySet set = makeCrackRays(m, 500, 500, 39);
             size_t cracks = 0, rays = 0;
             for (const auto* group : {&set.edgeRays, &set.vertexRays})
@@ -1047,13 +1116,20 @@ TEST_SUITE("bvh 4-wide") {
             CHECK(cracks == 0);
         }
     }
-    TEST_CASE("hard case: 4-wide identical centroids") {
+    TEST_CASE("4-wide: no cracks at shared edges and vertices") {
+        cracksCase<4>();
+    }
+    TEST_CASE("8-wide: no cracks at shared edges and vertices") {
+        cracksCase<8>();
+    }
+    template <int W>
+    void identicalCentroidsCase() {
         // 300 copies of one triangle: every builder splits in array order; the nearest is
         // the same t for all.
         Mesh m;
         m.positions = {{0, 0, 0}, {1, 0, 0}, {0, 1, 0}};
         for (int i = 0; i < 300; ++i) m.triangles.push_back({0, 1, 2});
-        Bvh4 wide = wideTree(m);
+        BvhWide<W> wide = wideTree<W>(m);
         checkStructure4(wide, 300);
         TraceHit h = traceNearest(wide, Ray(Vec3(0.25f, 0.25f, 2.0f), Vec3(0, 0, -1)));
         CHECK(h.t == 2.0f);
@@ -1062,7 +1138,14 @@ TEST_SUITE("bvh 4-wide") {
         CHECK(traceNearest(wide, Ray(Vec3(0.75f, 0.75f, 2.0f), Vec3(0, 0, -1))).triangle ==
               kNoPrimitive);
     }
-    TEST_CASE("hard case: 4-wide flat boxes of a planar mesh") {
+    TEST_CASE("hard case: 4-wide identical centroids") {
+        identicalCentroidsCase<4>();
+    }
+    TEST_CASE("hard case: 8-wide identical centroids") {
+        identicalCentroidsCase<8>();
+    }
+    template <int W>
+    void flatBoxesCase() {
         // A 20 x 20 grid of quads in the plane z = 0: every box has zero extent in z.
         test::FpTrapsOff nanOnPurpose;  // rays in the plane: 0 * infinity in the slab test
         Mesh m;
@@ -1074,7 +1157,7 @@ TEST_SUITE("bvh 4-wide") {
                 m.triangles.push_back({v, v + 1, v + 22});
                 m.triangles.push_back({v, v + 22, v + 21});
             }
-        Bvh4 wide = wideTree(m);
+        BvhWide<W> wide = wideTree<W>(m);
         checkStructure4(wide, m.triangleCount());
         std::mt19937_64 rng(40);
         std::uniform_real_distribution<float> u(-1.0f, 21.0f);
@@ -1092,8 +1175,15 @@ TEST_SUITE("bvh 4-wide") {
             CHECK(hitsAgree(traceNearest(wide, ray), traceBruteForce(m, ray)));
         }
     }
-    TEST_CASE("hard case: 4-wide empty mesh and one triangle") {
-        Bvh4 none = collapseToBvh4(Bvh{});
+    TEST_CASE("hard case: 4-wide flat boxes of a planar mesh") {
+        flatBoxesCase<4>();
+    }
+    TEST_CASE("hard case: 8-wide flat boxes of a planar mesh") {
+        flatBoxesCase<8>();
+    }
+    template <int W>
+    void emptyAndOneCase() {
+        BvhWide<W> none = collapseToWide<W>(Bvh{});
         CHECK(none.empty());
         Ray down(Vec3(0.25f, 0.25f, 1.0f), Vec3(0, 0, -1));
         CHECK(traceNearest(none, down).triangle == kNoPrimitive);
@@ -1101,7 +1191,7 @@ TEST_SUITE("bvh 4-wide") {
         Mesh one;
         one.positions = {{0, 0, 0}, {1, 0, 0}, {0, 1, 0}};
         one.triangles = {{0, 1, 2}};
-        Bvh4 wide = wideTree(one);
+        BvhWide<W> wide = wideTree<W>(one);
         REQUIRE(wide.nodes.size() == 1);  // a root whose one child is the leaf
         checkStructure4(wide, 1);
         CHECK(traceNearest(wide, down) == TraceHit{1.0f, 0u});
@@ -1109,13 +1199,20 @@ TEST_SUITE("bvh 4-wide") {
         CHECK(traceNearest(wide, Ray(Vec3(0.75f, 0.75f, 1.0f), Vec3(0, 0, -1))).triangle ==
               kNoPrimitive);
     }
-    TEST_CASE("hard case: 4-wide huge coordinates") {
+    TEST_CASE("hard case: 4-wide empty mesh and one triangle") {
+        emptyAndOneCase<4>();
+    }
+    TEST_CASE("hard case: 8-wide empty mesh and one triangle") {
+        emptyAndOneCase<8>();
+    }
+    template <int W>
+    void hugeCoordinatesCase() {
         // As in "hard cases 04": the float leaf test overflows this far out and falls back
         // to double (a NaN on purpose).
         test::FpTrapsOff overflowOnPurpose;
         Mesh m = triangleSoup(5000, 41, 0.01f);
         for (Vec3& p : m.positions) p = p * 1e20f + Vec3(3e20f, -1e20f, 0.0f);
-        Bvh4 wide = wideTree(m);
+        BvhWide<W> wide = wideTree<W>(m);
         checkStructure4(wide, m.triangleCount());
         for (uint32_t tri : {123u, 4000u}) {
             Vec3 target = (m.vertex(tri, 0) + m.vertex(tri, 1) + m.vertex(tri, 2)) / 3.0f;
@@ -1129,9 +1226,15 @@ TEST_SUITE("bvh 4-wide") {
         Mesh big;
         big.positions = {{-1e21f, -1e21f, -5e20f}, {1e21f, -1e21f, -5e20f}, {0.0f, 1e21f, -5e20f}};
         big.triangles = {{0, 1, 2}};
-        TraceHit h = traceNearest(wideTree(big), Ray(Vec3(0.0f), Vec3(0.0f, 0.0f, -1.0f)));
+        TraceHit h = traceNearest(wideTree<W>(big), Ray(Vec3(0.0f), Vec3(0.0f, 0.0f, -1.0f)));
         CHECK(h.triangle == 0u);
         CHECK(h.t == doctest::Approx(5e20).epsilon(1e-6));
+    }
+    TEST_CASE("hard case: 4-wide huge coordinates") {
+        hugeCoordinatesCase<4>();
+    }
+    TEST_CASE("hard case: 8-wide huge coordinates") {
+        hugeCoordinatesCase<8>();
     }
     TEST_CASE("batch tracing: the AVX2 loop and the baseline loop give the same bits") {
         // traceBatch runs a copy of the loop compiled for AVX2 where the CPU has it; the
@@ -1145,23 +1248,30 @@ TEST_SUITE("bvh 4-wide") {
         for (const Mesh* m : {&bunny, &far}) {
             Bvh binary = buildBvh(*m, BvhBuildOptions{});
             Bvh4 wide = collapseToBvh4(binary);
+            Bvh8 wide8 = collapseToBvh8(binary);
             for (RayKind kind : {RayKind::Primary, RayKind::Diffuse, RayKind::Random}) {
                 INFO(rayKindName(kind) << (m == &far ? " rays, far mesh" : " rays, bunny"));
                 std::vector<Ray> rays = m == &far ? raysAtTriangles(far, 3000, 5e20f, int(kind))
                                                   : makeRays(*m, kind, 3000, 43);
-                std::vector<TraceHit> fast2, fast4, base2, base4;
+                std::vector<TraceHit> fast2, fast4, fast8, base2, base4, base8;
                 traceBatch(binary, rays, fast2, 1);
                 traceBatch(wide, rays, fast4, 1);
+                traceBatch(wide8, rays, fast8, 1);
                 setenv("BOXES_NO_AVX2", "1", 1);
                 CHECK_FALSE(traceUsesAvx2());
                 traceBatch(binary, rays, base2, 1);
                 traceBatch(wide, rays, base4, 1);
+                traceBatch(wide8, rays, base8, 1);
                 unsetenv("BOXES_NO_AVX2");
                 size_t hits = 0;
                 for (const TraceHit& h : base2) hits += h.triangle != kNoPrimitive;
                 CHECK(hits > 100);
                 CHECK(std::memcmp(fast2.data(), base2.data(), rays.size() * sizeof(TraceHit)) == 0);
                 CHECK(std::memcmp(fast4.data(), base4.data(), rays.size() * sizeof(TraceHit)) == 0);
+                CHECK(std::memcmp(fast8.data(), base8.data(), rays.size() * sizeof(TraceHit)) == 0);
+                size_t disagree = 0;  // the 8-wide tree may break an exact tie another way
+                for (size_t i = 0; i < rays.size(); ++i) disagree += !hitsAgree(fast8[i], fast2[i]);
+                CHECK(disagree == 0);
                 CHECK(std::memcmp(fast2.data(), fast4.data(), rays.size() * sizeof(TraceHit)) == 0);
             }
         }
@@ -1244,6 +1354,17 @@ TEST_SUITE("program 04") {
         Bvh4Stats wide = bvh4Stats(collapseToBvh4(buildBvh(sh1, BvhBuildOptions{})));
         CHECK(run.out.find("\"nodes_4wide\":" + std::to_string(wide.nodes)) != std::string::npos);
         CHECK(checkHitsFileAgainstBruteForce(dir.file("hits.bin"), sh1, rays) > 100);
+        auto run8 = test::runProgram(program,
+                                     "trace --mesh " + test::dataDir() +
+                                         "/meshes/sh1.obj --rays rays.bin --hits hits8.bin "
+                                         "--builder sah --width 8",
+                                     dir);
+        INFO(run8.err);
+        REQUIRE(run8.exitCode == 0);
+        CHECK(run8.out.find("\"width\":8") != std::string::npos);
+        BvhWideStats wide8 = bvhWideStats(collapseToBvh8(buildBvh(sh1, BvhBuildOptions{})));
+        CHECK(run8.out.find("\"nodes_8wide\":" + std::to_string(wide8.nodes)) != std::string::npos);
+        CHECK(checkHitsFileAgainstBruteForce(dir.file("hits8.bin"), sh1, rays) > 100);
         auto bad = test::runProgram(program,
                                     "trace --mesh " + test::dataDir() +
                                         "/meshes/sh1.obj --rays rays.bin --hits h3.bin --width 3",
@@ -1262,6 +1383,7 @@ TEST_SUITE("program 04") {
         CHECK(run.exitCode == 0);
         CHECK(run.out.find("\"ok\":true") != std::string::npos);
         CHECK(run.out.find("\"sah-4wide\":{\"differ\":0}") != std::string::npos);
+        CHECK(run.out.find("\"sah-8wide\":{\"differ\":0}") != std::string::npos);
         auto bunny = test::runProgram(program,
                                       "check --mesh " + test::dataDir() +
                                           "/meshes/bunny.obj "

@@ -2,16 +2,16 @@
 """Step 04 beside Intel Embree: the same rays, back to back, one thread each.
 
 usage: tools/bench04.py [--rays N] [--repeat K] [--rounds R] [--meshes bunny,motorbike,oa_thor]
-                        [--kinds primary,diffuse,random] [--builders midpoint,median,sah,sah4]
+                        [--kinds primary,diffuse,random] [--builders midpoint,median,sah,sah4,sah8]
                         [--no-extras] [--thread-rays N] [--thread-pairs P]
                         [--out out/04_bvh_bench.json] [--data DIR] [--program PATH]
 
 For every mesh and ray kind (primary, diffuse, random) it writes one ray set with
 peer-bench's make_rays.py, runs peer-bench (Embree 3, one thread) and then our
-`04_bvh trace` with each builder on that file (and "sah 4-wide": the binned SAH tree
-collapsed to 4-wide nodes, `--width 4`), each run --repeat passes (the programs report
-the median), all of it --rounds times, alternating; the ratios are the medians of the
-rounds' own ratios. It compares the hits ray by ray with Embree's. The interior map (oa_thor)
+`04_bvh trace` with each builder on that file (and "sah 4-wide", "sah 8-wide": the
+binned SAH tree collapsed to 4- or 8-wide nodes, `--width 4` or `--width 8`), each run
+--repeat passes (the programs report the median), all of it --rounds times, alternating;
+the ratios are the medians of the rounds' own ratios. It compares the hits ray by ray with Embree's. The interior map (oa_thor)
 gets its primary rays from the inside camera of the meshes README. Also: binned SAH on
 2 threads against 1 beside Embree's own two-thread speed-up (larger ray sets, alternating
 pairs), and the full-sweep SAH cost (the quality reference). Prints the
@@ -125,8 +125,8 @@ def main():
                     help="runs of Embree and every builder, alternating (medians of the ratios)")
     ap.add_argument("--meshes", default="bunny,motorbike,oa_thor")
     ap.add_argument("--kinds", default="primary,diffuse,random")
-    ap.add_argument("--builders", default="midpoint,median,sah,sah4",
-                    help="sah4: the binned SAH tree collapsed to 4-wide nodes (SIMD)")
+    ap.add_argument("--builders", default="midpoint,median,sah,sah4,sah8",
+                    help="sah4, sah8: the binned SAH tree collapsed to 4- or 8-wide nodes (SIMD)")
     ap.add_argument("--no-extras", action="store_true",
                     help="skip the two-thread runs and the sweep-SAH quality reference")
     ap.add_argument("--thread-rays", type=int, default=500000,
@@ -160,9 +160,11 @@ def main():
             variants = [(b, args) for b, args in (
                 ("midpoint", ["--builder", "midpoint"]), ("median", ["--builder", "median"]),
                 ("sah", ["--builder", "sah"]),
-                # "sah 4-wide": the binned SAH tree collapsed to 4-wide nodes, SIMD traversal.
-                ("sah 4-wide", ["--builder", "sah", "--width", "4"]))
-                if b.replace(" 4-wide", "4") in a.builders.split(",")]
+                # "sah 4-wide", "sah 8-wide": the binned SAH tree collapsed to 4- or 8-wide
+                # nodes, SIMD traversal.
+                ("sah 4-wide", ["--builder", "sah", "--width", "4"]),
+                ("sah 8-wide", ["--builder", "sah", "--width", "8"]))
+                if b.replace(" 4-wide", "4").replace(" 8-wide", "8") in a.builders.split(",")]
             ehits, ohits = os.path.join(work, "embree.bin"), os.path.join(work, "ours.bin")
             embree_runs, our_runs, agree = [], {b: [] for b, _ in variants}, {}
             for round_index in range(a.rounds):
@@ -241,15 +243,16 @@ def main():
             continue
         print("  %-10s %.2fx  %.2fx" % (mesh, paired(by["sah"], by["midpoint"], "mrays_per_s"),
                                         paired(by["sah"], by["midpoint"], "mrays_per_cpu_s")))
-    print("\n4-wide (SIMD) against the binary tree, binned SAH (wall, CPU time):")
-    for mesh in a.meshes.split(","):
-        for kind in a.kinds.split(","):
-            by = {r["builder"]: r for r in rows if r["mesh"] == mesh and r["kind"] == kind}
-            if "sah" not in by or "sah 4-wide" not in by:
-                continue
-            print("  %-10s %-8s %.2fx  %.2fx" % (
-                mesh, kind, paired(by["sah 4-wide"], by["sah"], "mrays_per_s"),
-                paired(by["sah 4-wide"], by["sah"], "mrays_per_cpu_s")))
+    for wide in ("sah 4-wide", "sah 8-wide"):
+        print("\n%s (SIMD) against the binary tree, binned SAH (wall, CPU time):" % wide[4:])
+        for mesh in a.meshes.split(","):
+            for kind in a.kinds.split(","):
+                by = {r["builder"]: r for r in rows if r["mesh"] == mesh and r["kind"] == kind}
+                if "sah" not in by or wide not in by:
+                    continue
+                print("  %-10s %-8s %.2fx  %.2fx" % (
+                    mesh, kind, paired(by[wide], by["sah"], "mrays_per_s"),
+                    paired(by[wide], by["sah"], "mrays_per_cpu_s")))
     print("\nBuild and quality (binned SAH, 16 bins, one thread):")
     for q in quality:
         print("  %-10s %8d tris  %7.1f ms  %.3f s/Mtri (CPU %.3f)  SAH %.2f vs sweep %.2f "

@@ -6,9 +6,10 @@ namespace boxes {
 
 namespace {
 
+template <int W>
 struct Collapser {
     const Bvh& binary;
-    Bvh4& wide;
+    BvhWide<W>& wide;
     // Per binary node: the slots of its subtree, when they are one contiguous range (the
     // builders partition in place, so they are), else count 0.
     struct SlotRange {
@@ -60,13 +61,13 @@ struct Collapser {
         return first;
     }
 
-    // Emits the 4-wide node for the binary inner node `inner` (and, depth first, its
+    // Emits the wide node for the binary inner node `inner` (and, depth first, its
     // subtree); returns its index.
     uint32_t emit(uint32_t inner) {
         const BvhNode* b = binary.nodes.data();
-        uint32_t kids[4] = {b[inner].leftFirst, b[inner].leftFirst + 1, 0, 0};
+        uint32_t kids[W] = {b[inner].leftFirst, b[inner].leftFirst + 1};
         int n = 2;
-        while (n < 4) {
+        while (n < W) {
             // Open the inner child with the largest surface area (-1: flat and point boxes
             // have area 0 and are still opened).
             // (In double: in float the area of a box 1e20 across is infinite.)
@@ -95,18 +96,18 @@ struct Collapser {
             const BvhNode& c = b[kids[i]];
             bool leaf = becomesLeaf(kids[i]);
             uint32_t child = leaf ? emitLeaf(ranges[kids[i]]) : emit(kids[i]);
-            Bvh4Node& node = wide.nodes[index];  // after emit: the vector may have moved
+            BvhWideNode<W>& node = wide.nodes[index];  // after emit: the vector may have moved
             setChild(node, i, c.bounds(), child, leaf ? ranges[kids[i]].count : 0);
         }
         return index;
     }
 
-    static Bvh4Node emptyNode() {
-        Bvh4Node node{};
-        for (int i = 0; i < 4; ++i) setChild(node, i, Bounds3f(), 0, 0);
+    static BvhWideNode<W> emptyNode() {
+        BvhWideNode<W> node{};
+        for (int i = 0; i < W; ++i) setChild(node, i, Bounds3f(), 0, 0);
         return node;
     }
-    static void setChild(Bvh4Node& node, int i, const Bounds3f& bounds, uint32_t child,
+    static void setChild(BvhWideNode<W>& node, int i, const Bounds3f& bounds, uint32_t child,
                          uint32_t count) {
         for (int axis = 0; axis < 3; ++axis) {
             node.boundsMin[axis][i] = bounds.min[axis];
@@ -119,12 +120,14 @@ struct Collapser {
 
 }  // namespace
 
-Bvh4 collapseToBvh4(const Bvh& binary) {
-    Bvh4 wide;
+template <int W>
+BvhWide<W> collapseToWide(const Bvh& binary) {
+    BvhWide<W> wide;
     if (binary.empty()) return wide;
     wide.root.boundsMin = binary.nodes[0].boundsMin;
     wide.root.boundsMax = binary.nodes[0].boundsMax;
-    Collapser collapser{binary, wide, std::vector<Collapser::SlotRange>(binary.nodes.size())};
+    Collapser<W> collapser{binary, wide,
+                           std::vector<typename Collapser<W>::SlotRange>(binary.nodes.size())};
     collapser.computeRanges(0);
     // Reserved for leaves padded to whole packets (more only makes a vector grow), on huge
     // pages. What is never touched costs no memory, so there is no shrink_to_fit at the
@@ -137,26 +140,29 @@ Bvh4 collapseToBvh4(const Bvh& binary) {
     reserveOnHugePages(wide.packets, triangles ? slots / 2 + 1 : 0);
     const BvhNode& root = binary.nodes[0];
     if (collapser.becomesLeaf(0)) {
-        wide.nodes.push_back(Collapser::emptyNode());
+        wide.nodes.push_back(Collapser<W>::emptyNode());
         uint32_t first = collapser.emitLeaf(collapser.ranges[0]);
-        Collapser::setChild(wide.nodes[0], 0, root.bounds(), first, collapser.ranges[0].count);
+        Collapser<W>::setChild(wide.nodes[0], 0, root.bounds(), first, collapser.ranges[0].count);
     } else {
         reserveOnHugePages(wide.nodes, binary.nodes.size() / 2 + 1);
         collapser.emit(0);
     }
     return wide;
 }
+template Bvh4 collapseToWide<4>(const Bvh&);
+template Bvh8 collapseToWide<8>(const Bvh&);
 
-Bvh4Stats bvh4Stats(const Bvh4& bvh) {
-    Bvh4Stats s;
+template <int W>
+BvhWideStats bvhWideStats(const BvhWide<W>& bvh) {
+    BvhWideStats s;
     s.nodes = bvh.nodes.size();
     if (bvh.empty()) return s;
     std::vector<std::pair<uint32_t, int>> stack = {{0, 0}};
     while (!stack.empty()) {
         auto [index, depth] = stack.back();
         stack.pop_back();
-        const Bvh4Node& node = bvh.nodes[index];
-        for (int i = 0; i < 4; ++i) {
+        const BvhWideNode<W>& node = bvh.nodes[index];
+        for (int i = 0; i < W; ++i) {
             if (node.isEmpty(i)) {
                 ++s.emptySlots;
             } else if (node.isLeaf(i)) {
@@ -170,30 +176,45 @@ Bvh4Stats bvh4Stats(const Bvh4& bvh) {
     return s;
 }
 
+template BvhWideStats bvhWideStats<4>(const Bvh4&);
+template BvhWideStats bvhWideStats<8>(const Bvh8&);
+
 namespace {
 
-void traceRange(const Bvh4& bvh, const Ray* rays, TraceHit* hits, size_t begin, size_t end) {
-    for (size_t i = begin; i < end; ++i) hits[i] = traceNearest(bvh, rays[i]);
+template <bool kAvx, int W>
+void traceRange(const BvhWide<W>& bvh, const Ray* rays, TraceHit* hits, size_t begin, size_t end) {
+    for (size_t i = begin; i < end; ++i) hits[i] = traceNearest<kAvx>(bvh, rays[i]);
 }
 #if defined(BOXES_TARGET_AVX2)
-BOXES_TARGET_AVX2 void traceRangeAvx2(const Bvh4& bvh, const Ray* rays, TraceHit* hits,
+template <int W>
+BOXES_TARGET_AVX2 void traceRangeAvx2(const BvhWide<W>& bvh, const Ray* rays, TraceHit* hits,
                                       size_t begin, size_t end) {
-    traceRange(bvh, rays, hits, begin, end);
+    traceRange<true>(bvh, rays, hits, begin, end);
 }
 #endif
+
+template <int W>
+void traceWideBatch(const BvhWide<W>& bvh, const std::vector<Ray>& rays,
+                    std::vector<TraceHit>& hits, int threads) {
+    hits.resize(rays.size());
+    auto range = &traceRange<false, W>;
+#if defined(BOXES_TARGET_AVX2)
+    if (traceUsesAvx2()) range = &traceRangeAvx2<W>;
+#endif
+    forEachRayChunk(rays.size(), threads, [&](size_t begin, size_t end) {
+        range(bvh, rays.data(), hits.data(), begin, end);
+    });
+}
 
 }  // namespace
 
 void traceBatch(const Bvh4& bvh, const std::vector<Ray>& rays, std::vector<TraceHit>& hits,
                 int threads) {
-    hits.resize(rays.size());
-    auto range = &traceRange;
-#if defined(BOXES_TARGET_AVX2)
-    if (traceUsesAvx2()) range = &traceRangeAvx2;
-#endif
-    forEachRayChunk(rays.size(), threads, [&](size_t begin, size_t end) {
-        range(bvh, rays.data(), hits.data(), begin, end);
-    });
+    traceWideBatch(bvh, rays, hits, threads);
+}
+void traceBatch(const Bvh8& bvh, const std::vector<Ray>& rays, std::vector<TraceHit>& hits,
+                int threads) {
+    traceWideBatch(bvh, rays, hits, threads);
 }
 
 }  // namespace boxes

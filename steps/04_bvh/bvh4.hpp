@@ -1,4 +1,5 @@
-// Step 04, the advanced variant (not an exercise): a 4-wide hierarchy traversed with SIMD.
+// Step 04, the advanced variant (not an exercise): a 4-wide (and an 8-wide) hierarchy
+// traversed with SIMD.
 //
 // Layout (as Embree's BVH4 and tinybvh's BVH4): one node holds its four children's boxes
 // "structure of arrays", minimum x of the four children in one float[4], then minimum y, ...,
@@ -19,6 +20,10 @@
 // the same operations in the same order, kBoxFarScale on the far distance, and a NaN from
 // 0 * infinity (origin in a slab plane, zero direction component) ignored (the min/max
 // operand order below). The four entry distances and the scalar test's agree bit for bit.
+//
+// The 8-wide tree (Bvh8) is the same code with W = 8: eight boxes per node (256 bytes, four
+// cache lines), tested as two groups of four, one level for every three binary ones where
+// the 4-wide tree takes one for two. Embree traces with 8-wide nodes on CPUs with AVX.
 #pragma once
 
 #include <bit>
@@ -31,14 +36,20 @@
 #if defined(__SSE2__)
 #include <emmintrin.h>
 #endif
+#if defined(BOXES_TARGET_AVX2)
+#include <immintrin.h>
+#endif
 
 namespace boxes {
 
-struct alignas(64) Bvh4Node {
-    float boundsMin[3][4];  // [axis][child]
-    float boundsMax[3][4];
-    uint32_t child[4];  // inner child: node index; leaf: first slot; empty: 0
-    uint32_t count[4];  // 0: inner child (or empty slot), else the leaf's size
+template <int W>
+struct alignas(64) BvhWideNode {
+    static_assert(W == 4 || W == 8, "groups of four SSE lanes");
+    static constexpr int kWidth = W;
+    float boundsMin[3][W];  // [axis][child]
+    float boundsMax[3][W];
+    uint32_t child[W];  // inner child: node index; leaf: first slot; empty: 0
+    uint32_t count[W];  // 0: inner child (or empty slot), else the leaf's size
 
     bool isLeaf(int i) const { return count[i] != 0; }
     Bounds3f bounds(int i) const {
@@ -48,7 +59,10 @@ struct alignas(64) Bvh4Node {
     // An empty slot: an inverted box (+inf .. -inf) that every ray misses, NaN-free.
     bool isEmpty(int i) const { return count[i] == 0 && boundsMin[0][i] > boundsMax[0][i]; }
 };
+using Bvh4Node = BvhWideNode<4>;
+using Bvh8Node = BvhWideNode<8>;
 static_assert(sizeof(Bvh4Node) == 128, "two 64-byte cache lines");
+static_assert(sizeof(Bvh8Node) == 256, "four 64-byte cache lines");
 
 // Four triangles "structure of arrays" (vertex, axis, lane) for the 4-triangle leaf test.
 struct alignas(16) TrianglePacket4 {
@@ -58,8 +72,10 @@ struct alignas(16) TrianglePacket4 {
 // Slots are regrouped by four: every leaf starts a packet (slot first = 4 * packet), and
 // the lanes after a leaf's last triangle repeat that triangle (same primitive index), so
 // a leaf's slots [first, first + count) are packet lanes and a packet never mixes leaves.
-struct Bvh4 {
-    std::vector<Bvh4Node> nodes;  // nodes[0] is the root (when not empty); alignas: new aligns
+template <int W>
+struct BvhWide {
+    static constexpr int kWidth = W;
+    std::vector<BvhWideNode<W>> nodes;        // nodes[0] is the root (when not empty); new aligns
     std::vector<uint32_t> primitiveIndices;   // slot -> primitive
     std::vector<LeafTriangle> leafTriangles;  // meshes only: slot -> vertices
     std::vector<TrianglePacket4> packets;     // meshes only: the same by four
@@ -69,31 +85,46 @@ struct Bvh4 {
     Bounds3f bounds() const { return root.bounds(); }
     const BvhNode& rootNode() const { return root; }
 };
+using Bvh4 = BvhWide<4>;
+using Bvh8 = BvhWide<8>;
 
 // Collapses a binary hierarchy: its leaves are kept, and so is any subtree of at most
 // kBvh4MergedLeafSize primitives, as one leaf; their slots are regrouped into packets.
 constexpr uint32_t kBvh4MergedLeafSize = 8;
-Bvh4 collapseToBvh4(const Bvh& binary);
+template <int W>
+BvhWide<W> collapseToWide(const Bvh& binary);  // W = 4 or 8
+inline Bvh4 collapseToBvh4(const Bvh& binary) {
+    return collapseToWide<4>(binary);
+}
+inline Bvh8 collapseToBvh8(const Bvh& binary) {
+    return collapseToWide<8>(binary);
+}
 
-struct Bvh4Stats {
+struct BvhWideStats {
     size_t nodes = 0, leaves = 0, emptySlots = 0;
     int depth = 0;  // the deepest leaf; children of the root are depth 1
 };
-Bvh4Stats bvh4Stats(const Bvh4& bvh);
+using Bvh4Stats = BvhWideStats;
+template <int W>
+BvhWideStats bvhWideStats(const BvhWide<W>& bvh);  // W = 4 or 8
+inline Bvh4Stats bvh4Stats(const Bvh4& bvh) {
+    return bvhWideStats(bvh);
+}
 
-// A ray prepared for the four-box test: per axis the offset (in floats into a node) of the
+// A ray prepared for the W-box test: per axis the offset (in floats into a node) of the
 // plane array met first and of the one met last, and broadcast origins and 1/d.
-struct Bvh4Ray {
+template <int W>
+struct WideRay {
     int nearOffset[3], farOffset[3];
     float nearOrigin[3], farOrigin[3], inverseDirection[3], farInverseDirection[3], tmin;
 #if defined(__SSE2__)
     __m128 nearOriginV[3], farOriginV[3], inverseDirectionV[3], farInverseDirectionV[3], tminV;
 #endif
-    explicit Bvh4Ray(const TraversalRay& ray) : tmin(ray.tmin) {
+    explicit WideRay(const TraversalRay& ray) : tmin(ray.tmin) {
         for (int axis = 0; axis < 3; ++axis) {
             bool positive = ray.nearOffset[axis] == axis;  // the min plane first
-            nearOffset[axis] = positive ? 4 * axis : 12 + 4 * axis;
-            farOffset[axis] = positive ? 12 + 4 * axis : 4 * axis;
+            nearOffset[axis] = positive ? W * axis : 3 * W + W * axis;
+            farOffset[axis] = positive ? 3 * W + W * axis : W * axis;
             nearOrigin[axis] = ray.nearOrigin[axis];
             farOrigin[axis] = ray.farOrigin[axis];
             inverseDirection[axis] = (&ray.inverseDirection.x)[axis];
@@ -110,35 +141,42 @@ struct Bvh4Ray {
 #endif
     }
 };
+using Bvh4Ray = WideRay<4>;
 
-// The slab test of one ray against a node's four boxes in [ray.tmin, tmax]: bit i of the
+// The slab test of one ray against a node's W boxes in [ray.tmin, tmax]: bit i of the
 // result is set when the ray enters box i, at tEntry[i]. Per box, the same arithmetic as
-// intersectNodeBounds.
-inline int intersectChildBounds(const Bvh4Node& node, const Bvh4Ray& ray, float tmax,
-                                float tEntry[4]) {
+// intersectNodeBounds; groups of four boxes at a time.
+template <int W>
+inline int intersectChildBounds(const BvhWideNode<W>& node, const WideRay<W>& ray, float tmax,
+                                float tEntry[W]) {
     const float* planes = &node.boundsMin[0][0];
 #if defined(__SSE2__)
-    __m128 t0 = ray.tminV, t1 = _mm_set1_ps(tmax);
-    for (int axis = 0; axis < 3; ++axis) {
-        __m128 tNear = _mm_mul_ps(
-            _mm_sub_ps(_mm_load_ps(planes + ray.nearOffset[axis]), ray.nearOriginV[axis]),
-            ray.inverseDirectionV[axis]);
-        __m128 tFar =
-            _mm_mul_ps(_mm_sub_ps(_mm_load_ps(planes + ray.farOffset[axis]), ray.farOriginV[axis]),
-                       ray.farInverseDirectionV[axis]);
-        // maxps/minps return the second operand when either is NaN: the running bound
-        // goes second, so a NaN plane distance is ignored (as `tNear > t0 ? tNear : t0`).
-        t0 = _mm_max_ps(tNear, t0);
-        t1 = _mm_min_ps(tFar, t1);
+    int mask = 0;
+    for (int group = 0; group < W; group += 4) {
+        const float* p = planes + group;
+        __m128 t0 = ray.tminV, t1 = _mm_set1_ps(tmax);
+        for (int axis = 0; axis < 3; ++axis) {
+            __m128 tNear =
+                _mm_mul_ps(_mm_sub_ps(_mm_load_ps(p + ray.nearOffset[axis]), ray.nearOriginV[axis]),
+                           ray.inverseDirectionV[axis]);
+            __m128 tFar =
+                _mm_mul_ps(_mm_sub_ps(_mm_load_ps(p + ray.farOffset[axis]), ray.farOriginV[axis]),
+                           ray.farInverseDirectionV[axis]);
+            // maxps/minps return the second operand when either is NaN: the running bound
+            // goes second, so a NaN plane distance is ignored (as `tNear > t0 ? tNear : t0`).
+            t0 = _mm_max_ps(tNear, t0);
+            t1 = _mm_min_ps(tFar, t1);
+        }
+        _mm_storeu_ps(tEntry + group, t0);
+        // Empty slots (min > max) are masked out: with a non-finite origin (coordinates near
+        // the float range's end) every slab distance is NaN and every box looks entered.
+        __m128 filled = _mm_cmple_ps(_mm_load_ps(p), _mm_load_ps(p + 3 * W));
+        mask |= _mm_movemask_ps(_mm_and_ps(_mm_cmple_ps(t0, t1), filled)) << group;
     }
-    _mm_storeu_ps(tEntry, t0);
-    // Empty slots (min > max) are masked out: with a non-finite origin (coordinates near
-    // the float range's end) every slab distance is NaN and every box looks entered.
-    __m128 filled = _mm_cmple_ps(_mm_load_ps(planes), _mm_load_ps(planes + 12));
-    return _mm_movemask_ps(_mm_and_ps(_mm_cmple_ps(t0, t1), filled));
+    return mask;
 #else
     int mask = 0;
-    for (int i = 0; i < 4; ++i) {
+    for (int i = 0; i < W; ++i) {
         float t0 = ray.tmin, t1 = tmax;
         for (int axis = 0; axis < 3; ++axis) {
             float tNear = (planes[ray.nearOffset[axis] + i] - ray.nearOrigin[axis]) *
@@ -149,52 +187,98 @@ inline int intersectChildBounds(const Bvh4Node& node, const Bvh4Ray& ray, float 
             t1 = tFar < t1 ? tFar : t1;
         }
         tEntry[i] = t0;
-        mask |= int(t0 <= t1 && planes[i] <= planes[12 + i]) << i;  // not an empty slot
+        mask |= int(t0 <= t1 && planes[i] <= planes[3 * W + i]) << i;  // not an empty slot
     }
     return mask;
 #endif
 }
 
+#if defined(BOXES_TARGET_AVX2)
+// The same for eight boxes at once with AVX: the same operations lane by lane (vmaxps and
+// vminps treat a NaN as maxps and minps do), so the same bits. Only for code compiled for
+// AVX2 (the batch tracers' AVX2 loop, see traceUsesAvx2); tEntry aligned to 32 bytes.
+[[gnu::target("avx2")]] inline int intersectChildBoundsAvx(const Bvh8Node& node,
+                                                           const WideRay<8>& ray, float tmax,
+                                                           float tEntry[8]) {
+    const float* planes = &node.boundsMin[0][0];
+    __m256 t0 = _mm256_set1_ps(ray.tmin), t1 = _mm256_set1_ps(tmax);
+    for (int axis = 0; axis < 3; ++axis) {
+        __m256 tNear = _mm256_mul_ps(_mm256_sub_ps(_mm256_load_ps(planes + ray.nearOffset[axis]),
+                                                   _mm256_set1_ps(ray.nearOrigin[axis])),
+                                     _mm256_set1_ps(ray.inverseDirection[axis]));
+        __m256 tFar = _mm256_mul_ps(_mm256_sub_ps(_mm256_load_ps(planes + ray.farOffset[axis]),
+                                                  _mm256_set1_ps(ray.farOrigin[axis])),
+                                    _mm256_set1_ps(ray.farInverseDirection[axis]));
+        t0 = _mm256_max_ps(tNear, t0);
+        t1 = _mm256_min_ps(tFar, t1);
+    }
+    _mm256_store_ps(tEntry, t0);
+    // _CMP_LE_OS is cmpleps: the same (signalling) compare as the SSE test.
+    __m256 filled = _mm256_cmp_ps(_mm256_load_ps(planes), _mm256_load_ps(planes + 24), _CMP_LE_OS);
+    return _mm256_movemask_ps(_mm256_and_ps(_mm256_cmp_ps(t0, t1, _CMP_LE_OS), filled));
+}
+#endif
+
+// The box test the traversal runs: with kAvx (set only by code compiled for AVX2), the
+// 8-wide node's boxes in one AVX pass.
+template <bool kAvx, int W>
+[[gnu::always_inline]] inline int intersectChildBoundsFor(const BvhWideNode<W>& node,
+                                                          const WideRay<W>& ray, float tmax,
+                                                          float tEntry[W]) {
+#if defined(BOXES_TARGET_AVX2)
+    if constexpr (kAvx && W == 8) return intersectChildBoundsAvx(node, ray, tmax, tEntry);
+#endif
+    return intersectChildBounds(node, ray, tmax, tEntry);
+}
+
 // Asks for a postponed child's first cache lines: its fetch then overlaps the work on the
 // nearer children (incoherent rays spend most of their time waiting for nodes).
-inline void prefetchChild(const Bvh4& bvh, uint32_t child, uint32_t count) {
+template <int W>
+inline void prefetchChild(const BvhWide<W>& bvh, uint32_t child, uint32_t count) {
 #if defined(__SSE2__)
-    const char* p = count == 0 ? reinterpret_cast<const char*>(&bvh.nodes[child])
-                               : reinterpret_cast<const char*>(&bvh.packets[child / 4]);
-    _mm_prefetch(p, _MM_HINT_T0);
-    _mm_prefetch(p + 64, _MM_HINT_T0);
+    if (count == 0) {
+        const char* p = reinterpret_cast<const char*>(&bvh.nodes[child]);
+        for (int line = 0; line < W / 2; ++line) _mm_prefetch(p + 64 * line, _MM_HINT_T0);
+    } else {
+        const char* p = reinterpret_cast<const char*>(&bvh.packets[child / 4]);
+        _mm_prefetch(p, _MM_HINT_T0);
+        _mm_prefetch(p + 64, _MM_HINT_T0);
+    }
 #else
     (void)bvh, (void)child, (void)count;
 #endif
 }
 
-// Inner children push up to three entries per level, and the builders cap the depth at
-// kTraversalStackSize / 2 = 64.
-constexpr int kBvh4StackSize = 256;
-// A 4-wide node may span one binary level on a path and still push 3 entries.
-static_assert(kBvh4StackSize > 3 * (kTraversalStackSize / 2) + 4, "the builders' depth cap");
+// Inner children push up to W - 1 entries per level, and the builders cap the depth at
+// kTraversalStackSize / 2 = 64; a wide node may span one binary level on a path and still
+// push W - 1 entries.
+template <int W>
+constexpr int kWideStackSize = W == 4 ? 256 : 512;
+static_assert(kWideStackSize<4> > 3 * (kTraversalStackSize / 2) + 4, "the builders' depth cap");
+static_assert(kWideStackSize<8> > 7 * (kTraversalStackSize / 2) + 8, "the builders' depth cap");
+constexpr int kBvh4StackSize = kWideStackSize<4>;
 
 // Nearest hit, nearest child first, early out. intersectLeaf(first, count, tClosest) tests
 // a leaf's slots [first, first + count), lowers tClosest on a hit and returns the slot of
 // its nearest hit (or kTraversalMiss). Returns the slot of the nearest hit or kTraversalMiss.
-template <typename LeafIntersector>
-uint32_t traverseNearest4Leaves(const Bvh4& bvh, const TraversalRay& traversal, float& tClosest,
-                                LeafIntersector&& intersectLeaf) {
+template <bool kAvx = false, int W, typename LeafIntersector>
+uint32_t traverseNearest4Leaves(const BvhWide<W>& bvh, const TraversalRay& traversal,
+                                float& tClosest, LeafIntersector&& intersectLeaf) {
     if (bvh.empty()) return kTraversalMiss;
-    const Bvh4Ray ray(traversal);
-    const Bvh4Node* nodes = bvh.nodes.data();
+    const WideRay<W> ray(traversal);
+    const BvhWideNode<W>* nodes = bvh.nodes.data();
     struct Entry {
         uint32_t child, count;
         float tEntry;
-    } stack[kBvh4StackSize];
+    } stack[kWideStackSize<W>];
     int stackSize = 0;
     uint32_t nearestSlot = kTraversalMiss;
     uint32_t child = 0, count = 0;  // the root, an inner node
     for (;;) {
         if (count == 0) {
-            const Bvh4Node& node = nodes[child];
-            alignas(16) float t[4];
-            int mask = intersectChildBounds(node, ray, tClosest, t);
+            const BvhWideNode<W>& node = nodes[child];
+            alignas(32) float t[W];
+            int mask = intersectChildBoundsFor<kAvx>(node, ray, tClosest, t);
             if (mask != 0) {
                 int first = std::countr_zero(unsigned(mask));
                 mask &= mask - 1;
@@ -217,8 +301,8 @@ uint32_t traverseNearest4Leaves(const Bvh4& bvh, const TraversalRay& traversal, 
                     continue;
                 }
                 mask |= 1 << second;
-                // Three or four: sorted farthest first onto the stack, the nearest descended.
-                Entry hit[4];
+                // Three or more: sorted farthest first onto the stack, the nearest descended.
+                Entry hit[W];
                 hit[0] = {node.child[first], node.count[first], t[first]};
                 int hits = 1;
                 while (mask != 0) {
@@ -255,8 +339,8 @@ uint32_t traverseNearest4Leaves(const Bvh4& bvh, const TraversalRay& traversal, 
 }
 
 // The same with the interface of traverseNearest: intersect(slot, tClosest) per slot.
-template <typename PrimitiveIntersector>
-uint32_t traverseNearest4(const Bvh4& bvh, const TraversalRay& traversal, float& tClosest,
+template <int W, typename PrimitiveIntersector>
+uint32_t traverseNearest4(const BvhWide<W>& bvh, const TraversalRay& traversal, float& tClosest,
                           PrimitiveIntersector&& intersect) {
     return traverseNearest4Leaves(bvh, traversal, tClosest,
                                   [&](uint32_t first, uint32_t count, float& tmax) {
@@ -269,15 +353,15 @@ uint32_t traverseNearest4(const Bvh4& bvh, const TraversalRay& traversal, float&
 
 // Any hit in [ray.tmin, ray.tmax] (shadow rays): no order, stop at the first hit.
 // intersectLeaf(first, count, tmax) is true when a slot of the leaf is hit.
-template <typename LeafIntersector>
-bool traverseAny4Leaves(const Bvh4& bvh, const TraversalRay& traversal,
+template <int W, typename LeafIntersector>
+bool traverseAny4Leaves(const BvhWide<W>& bvh, const TraversalRay& traversal,
                         LeafIntersector&& intersectLeaf) {
     if (bvh.empty()) return false;
-    const Bvh4Ray ray(traversal);
-    const Bvh4Node* nodes = bvh.nodes.data();
+    const WideRay<W> ray(traversal);
+    const BvhWideNode<W>* nodes = bvh.nodes.data();
     struct Entry {
         uint32_t child, count;
-    } stack[kBvh4StackSize];
+    } stack[kWideStackSize<W>];
     int stackSize = 0;
     stack[stackSize++] = {0, 0};
     while (stackSize > 0) {
@@ -286,8 +370,8 @@ bool traverseAny4Leaves(const Bvh4& bvh, const TraversalRay& traversal,
             if (intersectLeaf(e.child, e.count, traversal.tmax)) return true;
             continue;
         }
-        const Bvh4Node& node = nodes[e.child];
-        alignas(16) float t[4];
+        const BvhWideNode<W>& node = nodes[e.child];
+        alignas(16) float t[W];
         int mask = intersectChildBounds(node, ray, traversal.tmax, t);
         while (mask != 0) {
             int i = std::countr_zero(unsigned(mask));
@@ -298,8 +382,8 @@ bool traverseAny4Leaves(const Bvh4& bvh, const TraversalRay& traversal,
     return false;
 }
 
-template <typename PrimitiveIntersector>
-bool traverseAny4(const Bvh4& bvh, const TraversalRay& traversal,
+template <int W, typename PrimitiveIntersector>
+bool traverseAny4(const BvhWide<W>& bvh, const TraversalRay& traversal,
                   PrimitiveIntersector&& intersect) {
     return traverseAny4Leaves(bvh, traversal, [&](uint32_t first, uint32_t count, float tmax) {
         for (uint32_t slot = first; slot < first + count; ++slot)
@@ -309,7 +393,8 @@ bool traverseAny4(const Bvh4& bvh, const TraversalRay& traversal,
 }
 
 // The margin of the scalar traversal, from the same root bounds.
-inline float traversalMargin(const Ray& ray, const Bvh4& bvh) {
+template <int W>
+inline float traversalMargin(const Ray& ray, const BvhWide<W>& bvh) {
     return bvh.empty() ? 0.0f : TraversalRay::marginFor(ray, bvh.bounds());
 }
 
@@ -335,9 +420,9 @@ struct WatertightRay4 {
 #endif
 };
 
-template <typename Axes>
+template <typename Axes, int W>
 inline uint32_t intersectLeafPackets(Axes axes, const WatertightRay& r, const WatertightRay4& r4,
-                                     const Bvh4& bvh, uint32_t first, uint32_t count,
+                                     const BvhWide<W>& bvh, uint32_t first, uint32_t count,
                                      float& tClosest) {
     uint32_t nearest = kTraversalMiss;
 #if defined(__SSE2__)
@@ -421,14 +506,16 @@ inline uint32_t intersectLeafPackets(Axes axes, const WatertightRay& r, const Wa
     return nearest;
 }
 
-inline TraceHit traceNearest(const Bvh4& bvh, const Ray& ray) {
+// kAvx: only from code compiled for AVX2 (the batch tracers' AVX2 loop).
+template <bool kAvx = false, int W>
+inline TraceHit traceNearest(const BvhWide<W>& bvh, const Ray& ray) {
     TraversalRay traversal(ray, traversalMargin(ray, bvh));
     if (!entersRoot(bvh, traversal)) return {};
     WatertightRay watertight(ray);
     WatertightRay4 watertight4(watertight);
     float tClosest = ray.tmax;
     uint32_t slot = withWatertightAxes(watertight, [&](auto axes) {
-        return traverseNearest4Leaves(
+        return traverseNearest4Leaves<kAvx>(
             bvh, traversal, tClosest, [&](uint32_t first, uint32_t count, float& tmax) {
                 return intersectLeafPackets(axes, watertight, watertight4, bvh, first, count, tmax);
             });
@@ -437,7 +524,8 @@ inline TraceHit traceNearest(const Bvh4& bvh, const Ray& ray) {
     return {tClosest, bvh.primitiveIndices[slot]};
 }
 
-inline bool traceOccluded(const Bvh4& bvh, const Ray& ray) {
+template <int W>
+inline bool traceOccluded(const BvhWide<W>& bvh, const Ray& ray) {
     TraversalRay traversal(ray, traversalMargin(ray, bvh));
     if (!entersRoot(bvh, traversal)) return false;
     WatertightRay watertight(ray);
@@ -451,6 +539,8 @@ inline bool traceOccluded(const Bvh4& bvh, const Ray& ray) {
 }
 
 void traceBatch(const Bvh4& bvh, const std::vector<Ray>& rays, std::vector<TraceHit>& hits,
+                int threads);
+void traceBatch(const Bvh8& bvh, const std::vector<Ray>& rays, std::vector<TraceHit>& hits,
                 int threads);
 
 }  // namespace boxes

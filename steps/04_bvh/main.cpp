@@ -43,11 +43,12 @@ int runTrace(const TraceOptions& o) {
     BvhBuildStats stats;
     double buildCpuStart = processCpuSeconds();
     Bvh bvh = buildBvh(mesh, build, &stats);
-    // --width 4: the binary tree collapsed to 4-wide nodes (bvh4.hpp); the collapse counts
-    // as build time.
+    // --width 4 or 8: the binary tree collapsed to 4- or 8-wide nodes (bvh4.hpp); the
+    // collapse counts as build time.
     Stopwatch collapseWatch;
     Bvh4 wide = o.width == 4 ? collapseToBvh4(bvh) : Bvh4{};
-    if (o.width == 4) stats.buildMs += collapseWatch.seconds() * 1e3;
+    Bvh8 wide8 = o.width == 8 ? collapseToBvh8(bvh) : Bvh8{};
+    if (o.width != 2) stats.buildMs += collapseWatch.seconds() * 1e3;
     double buildCpuSeconds = processCpuSeconds() - buildCpuStart;
     std::vector<TraceHit> hits;
     std::vector<double> seconds, cpuSeconds;
@@ -56,6 +57,8 @@ int runTrace(const TraceOptions& o) {
         double cpuStart = processCpuSeconds();
         if (o.width == 4)
             traceBatch(wide, rays, hits, o.threads);
+        else if (o.width == 8)
+            traceBatch(wide8, rays, hits, o.threads);
         else
             traceBatch(bvh, rays, hits, o.threads);
         seconds.push_back(watch.seconds());
@@ -82,11 +85,16 @@ int runTrace(const TraceOptions& o) {
                         {"nodes", stats.nodes},
                         {"depth", stats.depth},
                         {"sah_cost", stats.sahCost}};
-    // --width 4: the traced tree's own figures; nodes, depth and SAH cost stay the binary's.
+    // --width 4 or 8: the traced tree's own figures; nodes, depth and SAH cost stay the
+    // binary's.
     if (o.width == 4) {
-        Bvh4Stats wideStats = bvh4Stats(wide);
+        BvhWideStats wideStats = bvhWideStats(wide);
         j["nodes_4wide"] = wideStats.nodes;
         j["depth_4wide"] = wideStats.depth;
+    } else if (o.width == 8) {
+        BvhWideStats wideStats = bvhWideStats(wide8);
+        j["nodes_8wide"] = wideStats.nodes;
+        j["depth_8wide"] = wideStats.depth;
     }
     std::cout << j.dump() << "\n";
     return 0;
@@ -131,12 +139,17 @@ int runCheck(const CheckOptions& o) {
         }
         j[bvhBuilderName(builder)] = {{"differ", differ}, {"hits", hit}};
         total += differ;
-        if (builder == BvhBuilder::BinnedSah) {  // and its 4-wide collapse (bvh4.hpp)
+        if (builder == BvhBuilder::BinnedSah) {  // and its 4- and 8-wide collapses (bvh4.hpp)
+            auto countDiffering = [&] {
+                size_t n = 0;
+                for (size_t i = 0; i < rays.size(); ++i) n += !hitsAgree(hits[i], reference[i]);
+                total += n;
+                return n;
+            };
             traceBatch(collapseToBvh4(bvh), rays, hits, o.threads);
-            size_t differ4 = 0;
-            for (size_t i = 0; i < rays.size(); ++i) differ4 += !hitsAgree(hits[i], reference[i]);
-            j["sah-4wide"] = {{"differ", differ4}};
-            total += differ4;
+            j["sah-4wide"] = {{"differ", countDiffering()}};
+            traceBatch(collapseToBvh8(bvh), rays, hits, o.threads);
+            j["sah-8wide"] = {{"differ", countDiffering()}};
         }
     }
     if (o.cracks > 0) {
@@ -204,8 +217,9 @@ int main(int argc, char** argv) {
             ->capture_default_str();
         traceCommand
             ->add_option("--width", trace.width,
-                         "2: the binary tree; 4: its collapse to 4-wide nodes, SIMD traversal")
-            ->check(CLI::IsMember({2, 4}))
+                         "2: the binary tree; 4 or 8: its collapse to 4- or 8-wide nodes, SIMD "
+                         "traversal")
+            ->check(CLI::IsMember({2, 4, 8}))
             ->capture_default_str();
         traceCommand->add_option("--bins", trace.bins, "binned SAH: bins per axis")
             ->check(CLI::Range(2, 256))

@@ -148,17 +148,22 @@ Table measureBvhCracks(const std::vector<NamedMesh>& meshes, size_t raysPerFeatu
         "over the first 200 rays per row against brute force";
     for (const NamedMesh& m : meshes) {
         CrackRaySet set = makeCrackRays(*m.mesh, raysPerFeature, raysPerFeature, seed);
-        // The exercise builders, then (width 4) the binned SAH tree collapsed (bvh4.hpp).
-        for (int variant = 0; variant <= int(std::size(kExerciseBuilders)); ++variant) {
-            bool wide = variant == int(std::size(kExerciseBuilders));
-            BvhBuilder builder = wide ? BvhBuilder::BinnedSah : kExerciseBuilders[variant];
+        // The exercise builders, then the binned SAH tree collapsed to 4- and 8-wide nodes
+        // (bvh4.hpp).
+        constexpr int kBuilders = int(std::size(kExerciseBuilders));
+        for (int variant = 0; variant < kBuilders + 2; ++variant) {
+            int width = variant < kBuilders ? 2 : variant == kBuilders ? 4 : 8;
+            BvhBuilder builder = width > 2 ? BvhBuilder::BinnedSah : kExerciseBuilders[variant];
             Bvh bvh = buildBvh(*m.mesh, optionsFor(builder, 16));
-            Bvh4 bvh4 = wide ? collapseToBvh4(bvh) : Bvh4{};
+            Bvh4 bvh4 = width == 4 ? collapseToBvh4(bvh) : Bvh4{};
+            Bvh8 bvh8 = width == 8 ? collapseToBvh8(bvh) : Bvh8{};
             for (int feature = 0; feature < 2; ++feature) {
                 const auto& rays = feature == 0 ? set.edgeRays : set.vertexRays;
                 size_t cracks = 0, differ = 0;
                 for (const CrackRay& cr : rays) {
-                    TraceHit h = wide ? traceNearest(bvh4, cr.ray) : traceNearest(bvh, cr.ray);
+                    TraceHit h = width == 4   ? traceNearest(bvh4, cr.ray)
+                                 : width == 8 ? traceNearest(bvh8, cr.ray)
+                                              : traceNearest(bvh, cr.ray);
                     float target = kInfinity<float>;
                     WatertightRay w(cr.ray);
                     for (uint32_t tri : cr.triangles) {
@@ -172,7 +177,8 @@ Table measureBvhCracks(const std::vector<NamedMesh>& meshes, size_t raysPerFeatu
                         differ += !hitsAgree(h, traceBruteForce(*m.mesh, cr.ray));
                 }
                 t.row({m.name,
-                       wide ? std::string("sah 4-wide") : std::string(bvhBuilderName(builder)),
+                       width > 2 ? "sah " + std::to_string(width) + "-wide"
+                                 : std::string(bvhBuilderName(builder)),
                        std::string(feature == 0 ? "edges" : "vertices"), (long long)rays.size(),
                        (long long)cracks, (long long)differ});
             }

@@ -1337,34 +1337,29 @@ TEST_SUITE("program 04") {
             CHECK(run.out.find("\"hits\":" + std::to_string(hitCount)) != std::string::npos);
         }
     }
-    TEST_CASE("trace command: the 4-wide variant equals brute force") {
+    TEST_CASE("trace command: the 4- and 8-wide variants equal brute force") {
         test::TempDir dir;
         Mesh sh1 = loadObj(test::dataDir() + "/meshes/sh1.obj");
         std::vector<Ray> rays = makeRays(sh1, RayKind::Diffuse, 600, 4);
         writeRays(dir.file("rays.bin"), rays);
-        auto run = test::runProgram(program,
-                                    "trace --mesh " + test::dataDir() +
-                                        "/meshes/sh1.obj --rays rays.bin --hits hits.bin "
-                                        "--builder sah --width 4",
-                                    dir);
-        INFO(run.err);
-        REQUIRE(run.exitCode == 0);
-        CHECK(run.out.find("\"width\":4") != std::string::npos);
-        // The JSON names the traced tree's node count beside the binary one's.
-        Bvh4Stats wide = bvh4Stats(collapseToBvh4(buildBvh(sh1, BvhBuildOptions{})));
-        CHECK(run.out.find("\"nodes_4wide\":" + std::to_string(wide.nodes)) != std::string::npos);
-        CHECK(checkHitsFileAgainstBruteForce(dir.file("hits.bin"), sh1, rays) > 100);
-        auto run8 = test::runProgram(program,
-                                     "trace --mesh " + test::dataDir() +
-                                         "/meshes/sh1.obj --rays rays.bin --hits hits8.bin "
-                                         "--builder sah --width 8",
-                                     dir);
-        INFO(run8.err);
-        REQUIRE(run8.exitCode == 0);
-        CHECK(run8.out.find("\"width\":8") != std::string::npos);
-        BvhWideStats wide8 = bvhWideStats(collapseToBvh8(buildBvh(sh1, BvhBuildOptions{})));
-        CHECK(run8.out.find("\"nodes_8wide\":" + std::to_string(wide8.nodes)) != std::string::npos);
-        CHECK(checkHitsFileAgainstBruteForce(dir.file("hits8.bin"), sh1, rays) > 100);
+        Bvh binary = buildBvh(sh1, BvhBuildOptions{});
+        for (int width : {4, 8}) {
+            std::string w = std::to_string(width), hits = "hits" + w + ".bin";
+            auto run = test::runProgram(program,
+                                        "trace --mesh " + test::dataDir() +
+                                            "/meshes/sh1.obj --rays rays.bin --hits " + hits +
+                                            " --builder sah --width " + w,
+                                        dir);
+            INFO(run.err);
+            REQUIRE(run.exitCode == 0);
+            CHECK(run.out.find("\"width\":" + w) != std::string::npos);
+            // The JSON names the traced tree's node count beside the binary one's.
+            size_t nodes = width == 4 ? bvhWideStats(collapseToBvh4(binary)).nodes
+                                      : bvhWideStats(collapseToBvh8(binary)).nodes;
+            CHECK(run.out.find("\"nodes_" + w + "wide\":" + std::to_string(nodes)) !=
+                  std::string::npos);
+            CHECK(checkHitsFileAgainstBruteForce(dir.file(hits), sh1, rays) > 100);
+        }
         auto bad = test::runProgram(program,
                                     "trace --mesh " + test::dataDir() +
                                         "/meshes/sh1.obj --rays rays.bin --hits h3.bin --width 3",

@@ -45,7 +45,6 @@ namespace boxes {
 template <int W>
 struct alignas(64) BvhWideNode {
     static_assert(W == 4 || W == 8, "groups of four SSE lanes");
-    static constexpr int kWidth = W;
     float boundsMin[3][W];  // [axis][child]
     float boundsMax[3][W];
     uint32_t child[W];  // inner child: node index; leaf: first slot; empty: 0
@@ -74,7 +73,6 @@ struct alignas(16) TrianglePacket4 {
 // a leaf's slots [first, first + count) are packet lanes and a packet never mixes leaves.
 template <int W>
 struct BvhWide {
-    static constexpr int kWidth = W;
     std::vector<BvhWideNode<W>> nodes;        // nodes[0] is the root (when not empty); new aligns
     std::vector<uint32_t> primitiveIndices;   // slot -> primitive
     std::vector<LeafTriangle> leafTriangles;  // meshes only: slot -> vertices

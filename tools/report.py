@@ -56,6 +56,9 @@ def plot(report, spec, out, name):
     except ValueError:
         return None
     si = cols.index(spec["series"]) if spec.get("series") in cols else None
+    # "point_label": a column written beside every point (a series' points then differ by
+    # it, e.g. one point per mesh); without it a series of one point is labelled by name.
+    li = cols.index(spec["point_label"]) if spec.get("point_label") in cols else None
     fig, ax = plt.subplots(figsize=(6.4, 4.0), dpi=100)
     groups = {}
     for r in table["rows"]:
@@ -63,13 +66,17 @@ def plot(report, spec, out, name):
         if not isinstance(x, (int, float)) or not isinstance(y, (int, float)):
             continue
         key = str(r[si]) if si is not None else ""
-        groups.setdefault(key, []).append((x, y))
+        groups.setdefault(key, []).append((x, y, str(r[li]) if li is not None else ""))
     for key, pts in groups.items():
         pts.sort()
         style = "o-" if spec.get("lines") else "o"
         ax.plot([p[0] for p in pts], [p[1] for p in pts], style, label=key or None)
-        if not spec.get("lines") and len(pts) == 1:
-            ax.annotate(key, pts[0], textcoords="offset points", xytext=(5, 5), fontsize=8)
+        if li is not None:
+            for p in pts:
+                ax.annotate(p[2], p[:2], textcoords="offset points", xytext=(4, 3), fontsize=7,
+                            color="#555")
+        elif not spec.get("lines") and len(pts) == 1:
+            ax.annotate(key, pts[0][:2], textcoords="offset points", xytext=(5, 5), fontsize=8)
     if spec.get("logx"):
         ax.set_xscale("symlog" if any(p[0] <= 0 for g in groups.values() for p in g) else "log")
     if spec.get("logy"):

@@ -3,7 +3,7 @@
 
 usage: tools/bench04.py [--rays N] [--repeat K] [--rounds R] [--meshes bunny,motorbike,oa_thor]
                         [--kinds primary,diffuse,random] [--builders midpoint,median,sah,sah4,sah8]
-                        [--no-extras] [--thread-rays N] [--thread-pairs P]
+                        [--no-extras] [--thread-rays N] [--thread-pairs P] [--quiet-wait S]
                         [--out out/04_bvh_bench.json] [--data DIR] [--program PATH]
 
 For every mesh and ray kind (primary, diffuse, random) it writes one ray set with
@@ -11,8 +11,11 @@ peer-bench's make_rays.py, runs peer-bench (Embree 3, one thread) and then our
 `04_bvh trace` with each builder on that file (and "sah 4-wide", "sah 8-wide": the
 binned SAH tree collapsed to 4- or 8-wide nodes, `--width 4` or `--width 8`), each run
 --repeat passes (the programs report the median), all of it --rounds times, alternating;
-the ratios are the medians of the rounds' own ratios. It compares the hits ray by ray with Embree's. The interior map (oa_thor)
-gets its primary rays from the inside camera of the meshes README. Also: binned SAH on
+the ratios are the medians of the rounds' own ratios. Each round first waits (at most
+--quiet-wait s) until a short probe runs at 90% of its best speed: some minutes on a shared
+machine run memory-bound code 30-40% slower. It compares the hits ray by ray with Embree's.
+The interior map (oa_thor) gets its primary rays from the inside camera of the meshes
+README. Also: binned SAH on
 2 threads against 1 beside Embree's own two-thread speed-up (larger ray sets, alternating
 pairs), and the full-sweep SAH cost (the quality reference). Prints the
 table builder x ray kind x mesh and writes it as JSON (for the report).
@@ -28,6 +31,7 @@ import struct
 import subprocess
 import sys
 import tempfile
+import time
 
 ROOT = os.path.dirname(os.path.dirname(os.path.abspath(__file__)))
 PEER = "/work/shared/tools/peer-bench"
@@ -67,6 +71,54 @@ def run_ours(cmd, repeat):
     j = run_json(cmd + ["--repeat", str(repeat)])
     j["mrays_per_cpu_s"] = j["rays"] / max(1e-9, j["trace_cpu_ms"] / 1e3) / 1e6
     return j
+
+
+class QuietGate:
+    """Waits, before each round, for a minute in which memory-bound code runs at its usual
+    speed. On this shared machine some minutes run memory-bound code 30-40% slower (Embree
+    too, ours more) while the load average shows nothing; a round measured in one spoils its
+    ratios. The probe: our 8-wide tree on 100,000 diffuse rays of the bunny (about 0.3 s);
+    a round starts once the probe reaches 90% of the best it reached in this run, or after
+    --quiet-wait seconds."""
+
+    def __init__(self, a, peer_src, work):
+        self.cmd, self.best, self.waited, self.max_wait = None, 0.0, 0.0, a.quiet_wait
+        if a.quiet_wait <= 0:
+            return
+        obj = os.path.join(a.data, "bunny.obj")
+        if not os.path.exists(obj):
+            obj = os.path.join(a.data, a.meshes.split(",")[0] + ".obj")
+        rays = os.path.join(work, "probe.bin")
+        subprocess.run(["/usr/bin/python3", os.path.join(peer_src, "make_rays.py"), obj,
+                        "diffuse", "100000", rays, "--seed", "11"], check=True,
+                       capture_output=True)
+        self.cmd = [a.program, "trace", "--mesh", obj, "--rays", rays, "--hits",
+                    os.path.join(work, "probe-hits.bin"), "--width", "8", "--repeat", "3"]
+        for _ in range(3):  # a first reference
+            self.probe()
+
+    def probe(self):
+        speed = run_json(self.cmd)["mrays_per_s"]
+        self.best = max(self.best, speed)
+        return speed
+
+    def wait(self):
+        if self.cmd is None:
+            return
+        start = time.monotonic()
+        while True:
+            speed = self.probe()
+            if speed >= 0.9 * self.best:
+                break
+            waited = time.monotonic() - start
+            if waited >= self.max_wait:
+                print("  (the machine stayed slow: probe at %.0f%% of its best after %.0f s; "
+                      "measuring anyway)" % (100 * speed / self.best, waited), file=sys.stderr)
+                break
+            print("  waiting for a quiet minute: probe at %.0f%% of its best" %
+                  (100 * speed / self.best), file=sys.stderr)
+            time.sleep(5)
+        self.waited += time.monotonic() - start
 
 
 def round_ratios(ours, theirs, key):
@@ -137,6 +189,8 @@ def main():
     ap.add_argument("--out", default=os.path.join(ROOT, "out", "04_bvh_bench.json"))
     ap.add_argument("--program", default=os.path.join(ROOT, "build/release/steps/04_bvh/04_bvh"))
     ap.add_argument("--peer-dir", default=PEER)
+    ap.add_argument("--quiet-wait", type=float, default=60,
+                    help="seconds a round may wait for a quiet minute (0: no probe, no wait)")
     a = ap.parse_args()
 
     work = tempfile.mkdtemp(prefix="boxes-bench04-")
@@ -145,6 +199,7 @@ def main():
     # Embree's own build script uses -march=native: that is Embree's side, ours stays portable.
     subprocess.run(["sh", os.path.join(peer_src, "build.sh")], check=True, capture_output=True)
     peer = os.path.join(peer_src, "peer-bench")
+    gate = QuietGate(a, peer_src, work)
     rows, threads, quality = [], [], []
     for mesh in a.meshes.split(","):
         obj = os.path.join(a.data, mesh + ".obj")
@@ -168,6 +223,7 @@ def main():
             ehits, ohits = os.path.join(work, "embree.bin"), os.path.join(work, "ours.bin")
             embree_runs, our_runs, agree = [], {b: [] for b, _ in variants}, {}
             for round_index in range(a.rounds):
+                gate.wait()
                 embree_runs.append(run_embree([peer, obj, rays, ehits, "--threads", "1"],
                                               a.repeat))
                 eh = read_hits(ehits) if round_index == 0 else None
@@ -267,7 +323,8 @@ def main():
             t["mesh"], t["kind"], t["one"], t["two"], t["speedup"], t["embree_speedup"]))
     load = os.getloadavg()[0]
     print("\n(load average during the run: %.1f on %d cores; ratios are back to back, the "
-          "absolute figures drift with the load)" % (load, os.cpu_count()))
+          "absolute figures drift with the load; %.0f s spent waiting for quiet minutes)"
+          % (load, os.cpu_count(), gate.waited))
     os.makedirs(os.path.dirname(os.path.abspath(a.out)), exist_ok=True)
     cpu = "unknown CPU"
     try:
@@ -276,7 +333,7 @@ def main():
     except (OSError, IndexError):
         pass
     report = {"program": "04_bvh_bench", "images": [],
-              "machine": "%s, %d cores, load average %.1f" % (cpu, os.cpu_count(), load), "facts": {"load_average": os.getloadavg()[0]}, "rays": a.rays, "repeat": a.repeat, "load_average": load,
+              "machine": "%s, %d cores, load average %.1f" % (cpu, os.cpu_count(), load), "facts": {"load_average": os.getloadavg()[0]}, "rays": a.rays, "repeat": a.repeat, "load_average": load, "quiet_wait_s": gate.waited,
               "tables": [
                   {"id": "bench04_embree", "title": "Step 04 beside Embree 3: one thread each",
                    "columns": ["mesh", "rays", "builder", "Mrays/s", "Embree Mrays/s", "ratio",
@@ -289,8 +346,10 @@ def main():
                            "'ratio' (the median of the rounds' ratios) "
                            "from wall times, 'CPU ratio' from the CPU seconds of a trace pass "
                            "(ours: measured in the program; Embree: runs with --repeat 1 and 1+P, "
-                           "the difference over P (about 2 s of passes); steadier on a loaded machine); 'agree': share of rays with Embree's triangle or t"
-                           % (a.rounds, a.repeat)},
+                           "the difference over P (about 2 s of passes); steadier on a loaded machine); 'agree': share of rays with Embree's triangle or t; "
+                           "each round began once a probe ran at 90%% of its best speed (%.0f s "
+                           "of waiting in all, at most %.0f s per round)"
+                           % (a.rounds, a.repeat, gate.waited, a.quiet_wait)},
                   {"id": "bench04_build", "title": "Binned SAH build: time and quality",
                    "columns": ["mesh", "tris", "build ms", "s/Mtri", "CPU s/Mtri", "SAH cost",
                                "sweep SAH cost", "excess %"],

@@ -179,42 +179,13 @@ BvhWideStats bvhWideStats(const BvhWide<W>& bvh) {
 template BvhWideStats bvhWideStats<4>(const Bvh4&);
 template BvhWideStats bvhWideStats<8>(const Bvh8&);
 
-namespace {
-
-template <bool kAvx, int W>
-void traceRange(const BvhWide<W>& bvh, const Ray* rays, TraceHit* hits, size_t begin, size_t end) {
-    for (size_t i = begin; i < end; ++i) hits[i] = traceNearest<kAvx>(bvh, rays[i]);
-}
-#if defined(BOXES_TARGET_AVX2)
-template <int W>
-BOXES_TARGET_AVX2 void traceRangeAvx2(const BvhWide<W>& bvh, const Ray* rays, TraceHit* hits,
-                                      size_t begin, size_t end) {
-    traceRange<true>(bvh, rays, hits, begin, end);
-}
-#endif
-
-template <int W>
-void traceWideBatch(const BvhWide<W>& bvh, const std::vector<Ray>& rays,
-                    std::vector<TraceHit>& hits, int threads) {
-    hits.resize(rays.size());
-    auto range = &traceRange<false, W>;
-#if defined(BOXES_TARGET_AVX2)
-    if (traceUsesAvx2()) range = &traceRangeAvx2<W>;
-#endif
-    forEachRayChunk(rays.size(), threads, [&](size_t begin, size_t end) {
-        range(bvh, rays.data(), hits.data(), begin, end);
-    });
-}
-
-}  // namespace
-
 void traceBatch(const Bvh4& bvh, const std::vector<Ray>& rays, std::vector<TraceHit>& hits,
                 int threads) {
-    traceWideBatch(bvh, rays, hits, threads);
+    traceBatchOf(bvh, rays, hits, threads);
 }
 void traceBatch(const Bvh8& bvh, const std::vector<Ray>& rays, std::vector<TraceHit>& hits,
                 int threads) {
-    traceWideBatch(bvh, rays, hits, threads);
+    traceBatchOf(bvh, rays, hits, threads);
 }
 
 }  // namespace boxes

@@ -135,29 +135,9 @@ bool traceUsesAvx2() {
 #endif
 }
 
-namespace {
-
-void traceRange(const Bvh& bvh, const Ray* rays, TraceHit* hits, size_t begin, size_t end) {
-    for (size_t i = begin; i < end; ++i) hits[i] = traceNearest(bvh, rays[i]);
-}
-#if defined(BOXES_TARGET_AVX2)
-BOXES_TARGET_AVX2 void traceRangeAvx2(const Bvh& bvh, const Ray* rays, TraceHit* hits, size_t begin,
-                                      size_t end) {
-    traceRange(bvh, rays, hits, begin, end);
-}
-#endif
-
-}  // namespace
-
 void traceBatch(const Bvh& bvh, const std::vector<Ray>& rays, std::vector<TraceHit>& hits,
                 int threads) {
-    hits.resize(rays.size());
-    auto range = &traceRange;
-#if defined(BOXES_TARGET_AVX2)
-    if (traceUsesAvx2()) range = &traceRangeAvx2;
-#endif
-    runBatch(rays.size(), threads,
-             [&](size_t begin, size_t end) { range(bvh, rays.data(), hits.data(), begin, end); });
+    traceBatchOf(bvh, rays, hits, threads);
 }
 
 void forEachRayChunk(size_t count, int threads, const std::function<void(size_t, size_t)>& f) {

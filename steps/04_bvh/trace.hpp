@@ -173,6 +173,9 @@ template <typename Tree>
     return intersectNodeBounds(tree.rootNode(), traversal, traversal.tmax, tEntry);
 }
 
+// kAvx selects the wide trees' AVX box test (bvh4.hpp); the binary tree has none and
+// ignores it. The parameter lets one batch loop (traceBatchOf below) serve every tree.
+template <bool kAvx = false>
 inline TraceHit traceNearest(const Bvh& bvh, const Ray& ray) {
     TraversalRay traversal(ray, bvh);
     // Most rays of a camera framing a mesh miss its root box: decide that before the
@@ -250,6 +253,35 @@ void forEachRayChunk(size_t count, int threads, const std::function<void(size_t,
 // True when the batch tracers run their AVX2 loop: the CPU has AVX2 and the environment
 // does not set BOXES_NO_AVX2 (to measure or test the baseline loop). Read per batch.
 bool traceUsesAvx2();
+
+namespace detail {
+template <bool kAvx, typename Tree>
+void traceRange(const Tree& tree, const Ray* rays, TraceHit* hits, size_t begin, size_t end) {
+    for (size_t i = begin; i < end; ++i) hits[i] = traceNearest<kAvx>(tree, rays[i]);
+}
+#if defined(BOXES_TARGET_AVX2)
+template <typename Tree>
+BOXES_TARGET_AVX2 void traceRangeAvx2(const Tree& tree, const Ray* rays, TraceHit* hits,
+                                      size_t begin, size_t end) {
+    traceRange<true>(tree, rays, hits, begin, end);
+}
+#endif
+}  // namespace detail
+
+// The batch loop of every tree (Bvh, Bvh4, Bvh8): traceNearest on each ray, on `threads`
+// threads, in the AVX2 copy where traceUsesAvx2(). Each tree's traceBatch instantiates it.
+template <typename Tree>
+void traceBatchOf(const Tree& tree, const std::vector<Ray>& rays, std::vector<TraceHit>& hits,
+                  int threads) {
+    hits.resize(rays.size());
+    auto range = &detail::traceRange<false, Tree>;
+#if defined(BOXES_TARGET_AVX2)
+    if (traceUsesAvx2()) range = &detail::traceRangeAvx2<Tree>;
+#endif
+    forEachRayChunk(rays.size(), threads, [&](size_t begin, size_t end) {
+        range(tree, rays.data(), hits.data(), begin, end);
+    });
+}
 
 // Does a hierarchy's hit agree with brute force: the same triangle, or the same t (two
 // triangles sharing the hit point)?

@@ -38,6 +38,12 @@ PEER = "/work/shared/tools/peer-bench"
 INSIDE = ["--eye", "960,-384,2", "--look", "960,600,2", "--up", "0,0,1", "--fov", "90"]
 
 
+def make_rays(peer_src, obj, kind, count, out, extra=()):
+    """A ray set from peer-bench's make_rays.py (extra: its camera options, a seed)."""
+    subprocess.run(["/usr/bin/python3", os.path.join(peer_src, "make_rays.py"), obj, kind,
+                    str(count), out] + list(extra), check=True, capture_output=True)
+
+
 def run_json(cmd):
     out = subprocess.run(cmd, check=True, capture_output=True, text=True)
     return json.loads(out.stdout.strip().splitlines()[-1])
@@ -89,9 +95,7 @@ class QuietGate:
         if not os.path.exists(obj):
             obj = os.path.join(a.data, a.meshes.split(",")[0] + ".obj")
         rays = os.path.join(work, "probe.bin")
-        subprocess.run(["/usr/bin/python3", os.path.join(peer_src, "make_rays.py"), obj,
-                        "diffuse", "100000", rays, "--seed", "11"], check=True,
-                       capture_output=True)
+        make_rays(peer_src, obj, "diffuse", 100000, rays, ["--seed", "11"])
         self.cmd = [a.program, "trace", "--mesh", obj, "--rays", rays, "--hits",
                     os.path.join(work, "probe-hits.bin"), "--width", "8", "--repeat", "3"]
         for _ in range(3):  # a first reference
@@ -143,9 +147,7 @@ def measure_threads(a, peer, obj, mesh, kind, work):
     scaling on the same rays is what this machine's two cores allow."""
     rays = os.path.join(work, "%s-%s-threads.bin" % (mesh, kind))
     extra = INSIDE if (mesh == "oa_thor" and kind == "primary") else []
-    subprocess.run(["/usr/bin/python3", os.path.join(os.path.dirname(peer), "make_rays.py"), obj,
-                    kind, str(a.thread_rays), rays, "--seed", "7"] + extra, check=True,
-                   capture_output=True)
+    make_rays(os.path.dirname(peer), obj, kind, a.thread_rays, rays, ["--seed", "7"] + extra)
     hits = os.path.join(work, "threads-hits.bin")
     speed = {"ours": {1: [], 2: []}, "embree": {1: [], 2: []}}
     for _ in range(a.thread_pairs):
@@ -207,19 +209,19 @@ def main():
         for kind in a.kinds.split(","):
             rays = os.path.join(work, "%s-%s.bin" % (mesh, kind))
             extra = INSIDE if (mesh == "oa_thor" and kind == "primary") else []
-            subprocess.run(["/usr/bin/python3", os.path.join(peer_src, "make_rays.py"), obj, kind,
-                            str(a.rays), rays] + extra, check=True, capture_output=True)
+            make_rays(peer_src, obj, kind, a.rays, rays, extra)
             # Rounds: Embree, then every builder, again and again; each ratio is the median
             # of the rounds' own ratios, so a burst of load on this shared machine spoils
             # one round, not the comparison (a single run drifts by 10-20%).
-            variants = [(b, args) for b, args in (
-                ("midpoint", ["--builder", "midpoint"]), ("median", ["--builder", "median"]),
-                ("sah", ["--builder", "sah"]),
-                # "sah 4-wide", "sah 8-wide": the binned SAH tree collapsed to 4- or 8-wide
-                # nodes, SIMD traversal.
-                ("sah 4-wide", ["--builder", "sah", "--width", "4"]),
-                ("sah 8-wide", ["--builder", "sah", "--width", "8"]))
-                if b.replace(" 4-wide", "4").replace(" 8-wide", "8") in a.builders.split(",")]
+            # (row name, --builders name, trace options); "sah 4-wide", "sah 8-wide": the
+            # binned SAH tree collapsed to 4- or 8-wide nodes, SIMD traversal.
+            variants = [(b, args) for b, key, args in (
+                ("midpoint", "midpoint", ["--builder", "midpoint"]),
+                ("median", "median", ["--builder", "median"]),
+                ("sah", "sah", ["--builder", "sah"]),
+                ("sah 4-wide", "sah4", ["--builder", "sah", "--width", "4"]),
+                ("sah 8-wide", "sah8", ["--builder", "sah", "--width", "8"]))
+                if key in a.builders.split(",")]
             ehits, ohits = os.path.join(work, "embree.bin"), os.path.join(work, "ours.bin")
             embree_runs, our_runs, agree = [], {b: [] for b, _ in variants}, {}
             for round_index in range(a.rounds):

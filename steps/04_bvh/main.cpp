@@ -87,14 +87,11 @@ int runTrace(const TraceOptions& o) {
                         {"sah_cost", stats.sahCost}};
     // --width 4 or 8: the traced tree's own figures; nodes, depth and SAH cost stay the
     // binary's.
-    if (o.width == 4) {
-        BvhWideStats wideStats = bvhWideStats(wide);
-        j["nodes_4wide"] = wideStats.nodes;
-        j["depth_4wide"] = wideStats.depth;
-    } else if (o.width == 8) {
-        BvhWideStats wideStats = bvhWideStats(wide8);
-        j["nodes_8wide"] = wideStats.nodes;
-        j["depth_8wide"] = wideStats.depth;
+    if (o.width != 2) {
+        BvhWideStats wideStats = o.width == 4 ? bvhWideStats(wide) : bvhWideStats(wide8);
+        std::string suffix = "_" + std::to_string(o.width) + "wide";
+        j["nodes" + suffix] = wideStats.nodes;
+        j["depth" + suffix] = wideStats.depth;
     }
     std::cout << j.dump() << "\n";
     return 0;

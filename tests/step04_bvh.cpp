@@ -4,10 +4,12 @@
 #include <doctest/doctest.h>
 
 #include <algorithm>
+#include <atomic>
 #include <cstdlib>
 #include <cstring>
 #include <random>
 #include <set>
+#include <stdexcept>
 
 #include "01_triangle/measure.hpp"
 #include "04_bvh/bvh4.hpp"
@@ -714,6 +716,49 @@ TEST_SUITE("trace 04") {
                 CHECK(differ == 0);
                 CHECK(hits > 40);
             }
+        }
+    }
+    TEST_CASE("batch tracing on threads: every chunk once and the hits of one thread") {
+        // 10,000 indices are 10 chunks of 1,024; the pool of workers grows, shrinks and is
+        // reused between the calls.
+        constexpr size_t kCount = 10000;
+        for (int threads : {1, 2, 3, 4, 2, 2, 0}) {
+            INFO("threads " << threads);
+            std::vector<std::atomic<int>> seen(kCount);
+            forEachRayChunk(kCount, threads, [&](size_t begin, size_t end) {
+                for (size_t i = begin; i < end; ++i) seen[i]++;
+            });
+            CHECK(std::all_of(seen.begin(), seen.end(), [](const auto& s) { return s == 1; }));
+        }
+        // A batch started from inside a batch (the pool is busy) runs on threads of its own.
+        std::atomic<size_t> inner{0};
+        forEachRayChunk(3000, 2, [&](size_t begin, size_t end) {
+            forEachRayChunk(end - begin, 2, [&](size_t b, size_t e) { inner += e - b; });
+        });
+        CHECK(inner == 3000);
+        Mesh sh1 = loadObj(test::dataDir() + "/meshes/sh1.obj");
+        Bvh bvh = buildBvh(sh1, BvhBuildOptions{});
+        std::vector<Ray> rays = makeRays(sh1, RayKind::Diffuse, 5000, 23);
+        std::vector<TraceHit> one, three;
+        traceBatch(bvh, rays, one, 1);
+        traceBatch(bvh, rays, three, 3);
+        CHECK(one == three);
+    }
+    TEST_CASE("batch tracing on threads: an exception in a chunk reaches the caller") {
+        for (int threads : {1, 2}) {
+            std::atomic<size_t> done{0};
+            CHECK_THROWS_WITH_AS(forEachRayChunk(8192, threads,
+                                                 [&](size_t begin, size_t end) {
+                                                     if (begin == 4096)
+                                                         throw std::runtime_error("chunk 4");
+                                                     done += end - begin;
+                                                 }),
+                                 "chunk 4", std::runtime_error);
+            CHECK(done < 8192);
+            // The pool still works afterwards.
+            std::atomic<size_t> after{0};
+            forEachRayChunk(8192, threads, [&](size_t begin, size_t end) { after += end - begin; });
+            CHECK(after == 8192);
         }
     }
     TEST_CASE("the fast leaf test agrees with a double-precision reference") {

@@ -233,7 +233,8 @@ void writeRays(const std::string& path, const std::vector<Ray>& rays);
 void writeHits(const std::string& path, const std::vector<TraceHit>& hits);
 std::vector<TraceHit> readHits(const std::string& path);
 
-// Traces every ray on `threads` threads (chunks handed out dynamically).
+// Traces every ray on `threads` threads: the calling thread and workers kept between
+// batches, chunks of 1,024 rays handed out dynamically.
 void traceBatch(const Bvh& bvh, const std::vector<Ray>& rays, std::vector<TraceHit>& hits,
                 int threads);
 void traceBatchBruteForce(const Mesh& mesh, const std::vector<Ray>& rays,

@@ -157,7 +157,7 @@ T awaitChange(const std::atomic<T>& value, T old) {
 
 // Worker threads kept from one batch to the next, as a renderer keeps its threads, and the
 // calling thread works too (so `threads` threads need threads - 1 workers). Measured on 8-wide
-// passes over 250,000 bunny primary rays (paired rounds, two threads against one): two
+// passes over 200,000 bunny primary rays (paired rounds, two threads against one): two
 // threads started per batch while the caller waited in join() were no faster than one
 // (0.99-1.05x); the caller working beside one new thread, 1.69x; kept workers, 1.75x.
 class WorkerPool {

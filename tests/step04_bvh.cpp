@@ -5,11 +5,14 @@
 
 #include <algorithm>
 #include <atomic>
+#include <cfenv>
+#include <chrono>
 #include <cstdlib>
 #include <cstring>
 #include <random>
 #include <set>
 #include <stdexcept>
+#include <thread>
 
 #include "01_triangle/measure.hpp"
 #include "04_bvh/bvh4.hpp"
@@ -736,6 +739,21 @@ TEST_SUITE("trace 04") {
             forEachRayChunk(end - begin, 2, [&](size_t b, size_t e) { inner += e - b; });
         });
         CHECK(inner == 3000);
+        // Every thread works in the caller's floating-point environment (here its rounding
+        // mode), as a thread started for the batch would; the first chunk waits so that
+        // the other thread takes chunks too.
+        for (int mode : {FE_UPWARD, FE_TONEAREST}) {
+            std::fesetround(mode);
+            std::atomic<int> other{0}, chunks{0};
+            forEachRayChunk(8192, 2, [&](size_t begin, size_t) {
+                if (begin == 0) std::this_thread::sleep_for(std::chrono::milliseconds(20));
+                other += std::fegetround() != mode;
+                chunks++;
+            });
+            std::fesetround(FE_TONEAREST);
+            CHECK(chunks == 8);
+            CHECK(other == 0);
+        }
         Mesh sh1 = loadObj(test::dataDir() + "/meshes/sh1.obj");
         Bvh bvh = buildBvh(sh1, BvhBuildOptions{});
         std::vector<Ray> rays = makeRays(sh1, RayKind::Diffuse, 5000, 23);

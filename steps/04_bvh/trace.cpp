@@ -1,6 +1,7 @@
 #include "04_bvh/trace.hpp"
 
 #include <atomic>
+#include <cfenv>
 #include <chrono>
 #include <cstdlib>
 #include <cstring>
@@ -118,6 +119,9 @@ constexpr size_t kChunk = 1024;
 struct Batch {
     const std::function<void(size_t, size_t)>* f = nullptr;
     size_t count = 0;
+    // The caller's floating-point environment (rounding, the traps tests turn on), which
+    // a thread started for the batch would inherit; kept workers adopt it per batch.
+    std::fenv_t fpEnvironment;
     std::atomic<size_t> next{0};
     std::mutex failureMutex;
     std::exception_ptr failure;
@@ -203,6 +207,7 @@ private:
         for (;;) {
             seen = awaitChange(generation_, seen);
             if (stop_.load(std::memory_order_relaxed)) return;
+            std::fesetenv(&batch_->fpEnvironment);
             batch_->drain();
             if (pending_.fetch_sub(1, std::memory_order_acq_rel) == 1) pending_.notify_one();
         }
@@ -226,6 +231,7 @@ void runBatch(size_t count, int threads, const std::function<void(size_t, size_t
     Batch batch;
     batch.f = &f;
     batch.count = count;
+    std::fegetenv(&batch.fpEnvironment);
     if (threads == 1 || count <= kChunk) {
         batch.drain();
     } else if (!workerPool().run(batch, threads)) {

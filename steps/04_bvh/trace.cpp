@@ -226,23 +226,6 @@ WorkerPool& workerPool() {
     return pool;
 }
 
-void runBatch(size_t count, int threads, const std::function<void(size_t, size_t)>& f) {
-    if (threads <= 0) threads = int(std::max(1u, std::thread::hardware_concurrency()));
-    Batch batch;
-    batch.f = &f;
-    batch.count = count;
-    std::fegetenv(&batch.fpEnvironment);
-    if (threads == 1 || count <= kChunk) {
-        batch.drain();
-    } else if (!workerPool().run(batch, threads)) {
-        std::vector<std::thread> pool;
-        for (int i = 1; i < threads; ++i) pool.emplace_back([&] { batch.drain(); });
-        batch.drain();
-        for (auto& t : pool) t.join();
-    }
-    if (batch.failure) std::rethrow_exception(batch.failure);
-}
-
 }  // namespace
 
 bool traceUsesAvx2() {
@@ -260,7 +243,20 @@ void traceBatch(const Bvh& bvh, const std::vector<Ray>& rays, std::vector<TraceH
 }
 
 void forEachRayChunk(size_t count, int threads, const std::function<void(size_t, size_t)>& f) {
-    runBatch(count, threads, f);
+    if (threads <= 0) threads = int(std::max(1u, std::thread::hardware_concurrency()));
+    Batch batch;
+    batch.f = &f;
+    batch.count = count;
+    std::fegetenv(&batch.fpEnvironment);
+    if (threads == 1 || count <= kChunk) {
+        batch.drain();
+    } else if (!workerPool().run(batch, threads)) {
+        std::vector<std::thread> pool;
+        for (int i = 1; i < threads; ++i) pool.emplace_back([&] { batch.drain(); });
+        batch.drain();
+        for (auto& t : pool) t.join();
+    }
+    if (batch.failure) std::rethrow_exception(batch.failure);
 }
 
 void traceBatchBruteForce(const Mesh& mesh, const std::vector<Ray>& rays,
@@ -275,7 +271,7 @@ void traceBatchBruteForce(const Mesh& mesh, const std::vector<Ray>& rays,
     std::vector<LeafTriangle> triangles(triangleCount);
     for (size_t i = 0; i < triangleCount; ++i)
         triangles[i] = {mesh.vertex(i, 0), mesh.vertex(i, 1), mesh.vertex(i, 2)};
-    runBatch(rays.size(), threads, [&](size_t begin, size_t end) {
+    forEachRayChunk(rays.size(), threads, [&](size_t begin, size_t end) {
         std::vector<WatertightRay> prepared;
         std::vector<float> tClosest;
         for (size_t r = begin; r < end; ++r) {

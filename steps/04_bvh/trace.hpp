@@ -240,7 +240,8 @@ void traceBatch(const Bvh& bvh, const std::vector<Ray>& rays, std::vector<TraceH
 void traceBatchBruteForce(const Mesh& mesh, const std::vector<Ray>& rays,
                           std::vector<TraceHit>& hits, int threads);
 // The batch loop itself: f(begin, end) on chunks of [0, count), handed out dynamically to
-// `threads` threads (0: all cores). For other tracers of the step (the 4-wide one).
+// `threads` threads (0: all cores): the calling thread and workers kept between batches.
+// Every batch tracer of the step runs on it (traceBatchOf below, brute force).
 void forEachRayChunk(size_t count, int threads, const std::function<void(size_t, size_t)>& f);
 
 // The batch tracers' inner loop is compiled twice: for baseline x86-64 and, with every

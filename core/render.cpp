@@ -2,11 +2,12 @@
 
 #include <unistd.h>
 
+#include <atomic>
 #include <cstdio>
 #include <mutex>
 #include <random>
-#include <thread>
 
+#include "core/parallel.hpp"
 #include "core/timing.hpp"
 
 namespace boxes {
@@ -237,8 +238,7 @@ void Renderer::renderRows(Image& image, int rowBegin, int rowEnd, RayCounts& cou
 
 Image Renderer::render(RayCounts* counts) const {
     Image image(settings_.width, settings_.height);
-    int threads = settings_.threads > 0 ? settings_.threads
-                                        : int(std::max(1u, std::thread::hardware_concurrency()));
+    int threads = resolveThreads(settings_.threads);
     std::vector<RayCounts> perThread(static_cast<size_t>(threads));
     parallelRows(
         settings_.height, threads,
@@ -256,8 +256,7 @@ Image renderImage(const Scene& scene, const Camera& camera, const RenderSettings
 
 void parallelRows(int rows, int threads, const std::function<void(int, int)>& body,
                   const std::string& label) {
-    if (threads <= 0) threads = int(std::max(1u, std::thread::hardware_concurrency()));
-    threads = std::max(1, std::min(threads, rows));
+    threads = std::max(1, std::min(resolveThreads(threads), rows));
     std::atomic<int> next{0};
     std::atomic<int> done{0};
     std::mutex printMutex;
@@ -275,9 +274,7 @@ void parallelRows(int rows, int threads, const std::function<void(int, int)>& bo
                      label.c_str(), percent, now, final && tty ? "\n" : "");
         std::fflush(stderr);
     };
-    std::exception_ptr error;
-    std::mutex errorMutex;
-    auto worker = [&](int thread) {
+    runOnThreads(threads, [&](int thread) {
         try {
             for (int row; (row = next.fetch_add(1)) < rows;) {
                 body(row, thread);
@@ -285,16 +282,10 @@ void parallelRows(int rows, int threads, const std::function<void(int, int)>& bo
                 report(false);
             }
         } catch (...) {
-            std::lock_guard<std::mutex> lock(errorMutex);
-            if (!error) error = std::current_exception();
             next = rows;  // stop the others
+            throw;
         }
-    };
-    std::vector<std::thread> pool;
-    for (int t = 1; t < threads; ++t) pool.emplace_back(worker, t);
-    worker(0);
-    for (auto& t : pool) t.join();
-    if (error) std::rethrow_exception(error);
+    });
     report(true);
 }
 

@@ -74,8 +74,9 @@ private:
 Image renderImage(const Scene& scene, const Camera& camera, const RenderSettings& settings,
                   RayCounts* counts = nullptr);
 
-// Runs body(row) for every row on `threads` threads (0: all), rows handed out one at a
-// time; prints progress for long runs when label is not empty.
+// Runs body(row) for every row on `threads` threads (0: all; the caller and kept workers,
+// see core/parallel.hpp), rows handed out one at a time; prints progress for long runs
+// when label is not empty. The first exception from body stops the rest and is rethrown.
 void parallelRows(int rows, int threads, const std::function<void(int row, int thread)>& body,
                   const std::string& label = "");
 

@@ -1,8 +1,16 @@
 // The mini-core: images, meshes, timing, tables, scenes and the renderer's promise 3.
+#include <algorithm>
+#include <atomic>
+#include <cfenv>
+#include <chrono>
 #include <cmath>
+#include <stdexcept>
+#include <thread>
+#include <vector>
 
 #include "core/image.hpp"
 #include "core/mesh.hpp"
+#include "core/parallel.hpp"
 #include "core/render.hpp"
 #include "core/report.hpp"
 #include "core/scene.hpp"
@@ -111,6 +119,70 @@ TEST_SUITE("core") {
         std::ostringstream out;
         t.print(out);
         CHECK(out.str().find("bb") != std::string::npos);
+    }
+    TEST_CASE("threads: every thread index once, thread 0 the caller, workers kept") {
+        // The kept workers grow, shrink and are reused between the calls.
+        for (int threads : {1, 2, 3, 4, 2, 2, 0}) {
+            INFO("threads " << threads);
+            int n = resolveThreads(threads);
+            std::vector<std::atomic<int>> ran(size_t(n) + 1);
+            std::atomic<bool> zeroOnCaller{false};
+            const auto caller = std::this_thread::get_id();
+            runOnThreads(threads, [&](int t) {
+                ran[size_t(std::clamp(t, 0, n))]++;
+                if (t == 0) zeroOnCaller = std::this_thread::get_id() == caller;
+            });
+            for (int t = 0; t < n; ++t) CHECK(ran[size_t(t)] == 1);
+            CHECK(ran[size_t(n)] == 0);
+            CHECK(zeroOnCaller);
+        }
+        CHECK(resolveThreads(0) >= 1);
+        CHECK(resolveThreads(3) == 3);
+        // A call from inside a task (the workers are busy) runs on threads of its own.
+        std::atomic<int> inner{0};
+        runOnThreads(2, [&](int) { runOnThreads(3, [&](int) { inner++; }); });
+        CHECK(inner == 6);
+    }
+    TEST_CASE("threads: every worker runs in the caller's floating-point environment") {
+        // A kept worker started under another rounding mode; thread 0 waits so the other
+        // thread's task surely runs while the caller is inside runOnThreads.
+        runOnThreads(2, [](int) {});
+        for (int mode : {FE_UPWARD, FE_DOWNWARD, FE_TONEAREST}) {
+            std::fesetround(mode);
+            std::atomic<int> wrong{0};
+            runOnThreads(2, [&](int t) {
+                if (t == 0) std::this_thread::sleep_for(std::chrono::milliseconds(5));
+                wrong += std::fegetround() != mode;
+            });
+            std::fesetround(FE_TONEAREST);
+            CHECK(wrong == 0);
+        }
+    }
+    TEST_CASE(
+        "threads: parallelRows runs every row once; an exception stops it and reaches "
+        "the caller") {
+        for (int threads : {1, 2, 3}) {
+            INFO("threads " << threads);
+            std::vector<std::atomic<int>> seen(500);
+            std::atomic<int> badThread{0};
+            parallelRows(500, threads, [&](int row, int thread) {
+                seen[size_t(row)]++;
+                badThread += thread < 0 || thread >= threads;
+            });
+            CHECK(std::all_of(seen.begin(), seen.end(), [](const auto& s) { return s == 1; }));
+            CHECK(badThread == 0);
+            std::atomic<int> rows{0};
+            CHECK_THROWS_WITH_AS(parallelRows(100000, threads,
+                                              [&](int row, int) {
+                                                  if (row == 10) throw std::runtime_error("row 10");
+                                                  rows++;
+                                              }),
+                                 "row 10", std::runtime_error);
+            CHECK(rows < 100000 - 1);  // the others stopped early
+            std::atomic<int> after{0};
+            parallelRows(64, threads, [&](int, int) { after++; });
+            CHECK(after == 64);
+        }
     }
     TEST_CASE("scene: the nearest of spheres and planes") {
         Scene s;

@@ -1,20 +1,15 @@
 #include "04_bvh/trace.hpp"
 
+#include <algorithm>
 #include <atomic>
-#include <cfenv>
-#include <chrono>
 #include <cstdlib>
 #include <cstring>
 #include <filesystem>
 #include <fstream>
-#include <mutex>
 #include <random>
-#include <thread>
-#if defined(__SSE2__)
-#include <emmintrin.h>
-#endif
 
 #include "core/image.hpp"
+#include "core/parallel.hpp"
 
 namespace boxes {
 
@@ -110,124 +105,6 @@ std::vector<TraceHit> readHits(const std::string& path) {
     return hits;
 }
 
-namespace {
-
-constexpr size_t kChunk = 1024;
-
-// Hands chunks of [0, count) to the calling thread and the pool's workers; the first
-// exception thrown by f ends the batch early and is rethrown by the caller.
-struct Batch {
-    const std::function<void(size_t, size_t)>* f = nullptr;
-    size_t count = 0;
-    // The caller's floating-point environment (rounding, the traps tests turn on), which
-    // a thread started for the batch would inherit; kept workers adopt it per batch.
-    std::fenv_t fpEnvironment;
-    std::atomic<size_t> next{0};
-    std::mutex failureMutex;
-    std::exception_ptr failure;
-
-    void drain() {
-        try {
-            for (;;) {
-                size_t begin = next.fetch_add(kChunk, std::memory_order_relaxed);
-                if (begin >= count) return;
-                (*f)(begin, std::min(count, begin + kChunk));
-            }
-        } catch (...) {
-            next.store(count, std::memory_order_relaxed);
-            std::lock_guard lock(failureMutex);
-            if (!failure) failure = std::current_exception();
-        }
-    }
-};
-
-// Spins for about a millisecond, then sleeps, until `value` is no longer `old`: a repeated
-// trace starts its next batch within microseconds, and waking a sleeping thread costs
-// 0.1-0.4 ms on this VM (a few percent of a two-thread pass over 250,000 rays).
-template <typename T>
-T awaitChange(const std::atomic<T>& value, T old) {
-    auto until = std::chrono::steady_clock::now() + std::chrono::milliseconds(1);
-    for (int spin = 0;; ++spin) {
-        T now = value.load(std::memory_order_acquire);
-        if (now != old) return now;
-        if ((spin & 63) == 0 && std::chrono::steady_clock::now() > until) break;
-#if defined(__SSE2__)
-        _mm_pause();
-#endif
-    }
-    value.wait(old, std::memory_order_acquire);
-    return value.load(std::memory_order_acquire);
-}
-
-// Worker threads kept from one batch to the next, as a renderer keeps its threads, and the
-// calling thread works too (so `threads` threads need threads - 1 workers). Measured on 8-wide
-// passes over 200,000 bunny primary rays (paired rounds, two threads against one): two
-// threads started per batch while the caller waited in join() were no faster than one
-// (0.99-1.05x); the caller working beside one new thread, 1.69x; kept workers, 1.75x.
-class WorkerPool {
-public:
-    ~WorkerPool() { resize(0); }
-
-    // false when the pool is busy (a batch from another thread, or from inside f): the
-    // caller then starts threads of its own.
-    bool run(Batch& batch, int threads) {
-        if (busy_.exchange(true, std::memory_order_acquire)) return false;
-        struct Release {
-            std::atomic<bool>& busy;
-            ~Release() { busy.store(false, std::memory_order_release); }
-        } release{busy_};
-        resize(threads - 1);
-        batch_ = &batch;
-        pending_.store(int(workers_.size()), std::memory_order_relaxed);
-        generation_.fetch_add(1, std::memory_order_release);
-        generation_.notify_all();
-        batch.drain();
-        for (int left = pending_.load(std::memory_order_acquire); left != 0;)
-            left = awaitChange(pending_, left);
-        return true;
-    }
-
-private:
-    void resize(size_t workers) {
-        if (workers_.size() == workers) return;
-        if (!workers_.empty()) {
-            stop_.store(true, std::memory_order_relaxed);
-            generation_.fetch_add(1, std::memory_order_release);
-            generation_.notify_all();
-            for (std::thread& t : workers_) t.join();
-            workers_.clear();
-            stop_.store(false, std::memory_order_relaxed);
-        }
-        uint64_t current = generation_.load(std::memory_order_relaxed);
-        for (size_t i = 0; i < workers; ++i)
-            workers_.emplace_back([this, current] { work(current); });
-    }
-
-    void work(uint64_t seen) {
-        for (;;) {
-            seen = awaitChange(generation_, seen);
-            if (stop_.load(std::memory_order_relaxed)) return;
-            std::fesetenv(&batch_->fpEnvironment);
-            batch_->drain();
-            if (pending_.fetch_sub(1, std::memory_order_acq_rel) == 1) pending_.notify_one();
-        }
-    }
-
-    std::atomic<bool> busy_{false};
-    std::vector<std::thread> workers_;
-    std::atomic<uint64_t> generation_{0};
-    std::atomic<int> pending_{0};
-    std::atomic<bool> stop_{false};
-    Batch* batch_ = nullptr;
-};
-
-WorkerPool& workerPool() {
-    static WorkerPool pool;
-    return pool;
-}
-
-}  // namespace
-
 bool traceUsesAvx2() {
 #if defined(BOXES_TARGET_AVX2)
     static const bool cpu = __builtin_cpu_supports("avx2");  // checks the OS saves YMM too
@@ -243,20 +120,19 @@ void traceBatch(const Bvh& bvh, const std::vector<Ray>& rays, std::vector<TraceH
 }
 
 void forEachRayChunk(size_t count, int threads, const std::function<void(size_t, size_t)>& f) {
-    if (threads <= 0) threads = int(std::max(1u, std::thread::hardware_concurrency()));
-    Batch batch;
-    batch.f = &f;
-    batch.count = count;
-    std::fegetenv(&batch.fpEnvironment);
-    if (threads == 1 || count <= kChunk) {
-        batch.drain();
-    } else if (!workerPool().run(batch, threads)) {
-        std::vector<std::thread> pool;
-        for (int i = 1; i < threads; ++i) pool.emplace_back([&] { batch.drain(); });
-        batch.drain();
-        for (auto& t : pool) t.join();
-    }
-    if (batch.failure) std::rethrow_exception(batch.failure);
+    constexpr size_t kChunk = 1024;
+    std::atomic<size_t> next{0};
+    auto drain = [&](int) {
+        try {
+            for (size_t begin; (begin = next.fetch_add(kChunk, std::memory_order_relaxed)) < count;)
+                f(begin, std::min(count, begin + kChunk));
+        } catch (...) {
+            next.store(count, std::memory_order_relaxed);  // stop the others
+            throw;
+        }
+    };
+    if (count <= kChunk) return drain(0);
+    runOnThreads(threads, drain);
 }
 
 void traceBatchBruteForce(const Mesh& mesh, const std::vector<Ray>& rays,

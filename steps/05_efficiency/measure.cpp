@@ -7,11 +7,11 @@
 #include <cstring>
 #include <memory>
 #include <random>
-#include <thread>
 
 #include "05_efficiency/bvh_mesh.hpp"
 #include "05_efficiency/lab.hpp"
 #include "05_efficiency/progressive.hpp"
+#include "core/parallel.hpp"
 #include "core/timing.hpp"
 
 namespace boxes {
@@ -812,7 +812,7 @@ const char* scheduleName(Schedule s) {
 Image renderScheduled(const Renderer& renderer, int threads, Schedule schedule) {
     const int w = renderer.settings().width, h = renderer.settings().height;
     Image image(w, h);
-    if (threads <= 0) threads = int(std::max(1u, std::thread::hardware_concurrency()));
+    threads = resolveThreads(threads);
     if (schedule == Schedule::DynamicRows) {
         parallelRows(h, threads, [&](int row, int) {
             RayCounts c;
@@ -846,7 +846,7 @@ Table measureThreads(const Scene& scene, const LabOptions& o) {
     t.title = "Threads: speed-up over one thread, and how the work is handed out";
     t.columns = {"threads",  "schedule",     "ms/frame",     "min ms",   "max ms",
                  "speed-up", "speed-up min", "speed-up max", "identical"};
-    int all = int(std::max(1u, std::thread::hardware_concurrency()));
+    int all = resolveThreads(0);
     const int repeats = std::max(o.repeats, 7);
     t.note = "scene '" + scene.name + "', " + std::to_string(sized(o, 320)) + "x" +
              std::to_string(sized(o, 240)) + ", " + std::to_string(repeats) +

@@ -22,16 +22,19 @@ const char* bvhBuilderName(BvhBuilder builder) {
             return "median";
         case BvhBuilder::BinnedSah:
             return "sah";
-        default:
+        case BvhBuilder::SweepSah:
             return "sweep-sah";
+        default:
+            return "sbvh";
     }
 }
 
 BvhBuilder parseBvhBuilder(const std::string& name) {
-    for (BvhBuilder b :
-         {BvhBuilder::Midpoint, BvhBuilder::Median, BvhBuilder::BinnedSah, BvhBuilder::SweepSah})
+    for (BvhBuilder b : {BvhBuilder::Midpoint, BvhBuilder::Median, BvhBuilder::BinnedSah,
+                         BvhBuilder::SweepSah, BvhBuilder::SpatialSah})
         if (name == bvhBuilderName(b)) return b;
-    throw InputError("unknown builder '" + name + "' (use midpoint, median, sah or sweep-sah)");
+    throw InputError("unknown builder '" + name +
+                     "' (use midpoint, median, sah, sweep-sah or sbvh)");
 }
 
 // EXERCISE 4.1: midpoint split along the longest axis of the centroid bounds (2 points)
@@ -359,7 +362,8 @@ public:
 private:
     bool isSah() const {
         return options_.builder == BvhBuilder::BinnedSah ||
-               options_.builder == BvhBuilder::SweepSah;
+               options_.builder == BvhBuilder::SweepSah ||
+               options_.builder == BvhBuilder::SpatialSah;
     }
 
     void buildNode(uint32_t nodeIndex, size_t begin, size_t end, int depth) {
@@ -394,6 +398,7 @@ private:
                 left = partitionMedian(range, centroids);
                 break;
             case BvhBuilder::BinnedSah:
+            case BvhBuilder::SpatialSah:  // bare bounds: nothing to clip
                 left = partitionBinnedSah(range, bounds, centroids, options_, splitCost);
                 break;
             case BvhBuilder::SweepSah:
@@ -470,8 +475,14 @@ Bvh buildBvh(const Mesh& mesh, const BvhBuildOptions& options, BvhBuildStats* st
         for (int k = 0; k < 3; ++k) b.extend(mesh.vertex(i, k));
         prims.push_back({b, b.centroid(), uint32_t(i)});
     }
-    Bvh bvh = buildFromPrimitives(prims, options);
-    reserveOnHugePages(bvh.leafTriangles, prims.size());
+    Bvh bvh;
+    if (options.builder == BvhBuilder::SpatialSah) {
+        checkOptions(options);
+        bvh = buildSpatialSplitBvh(mesh, {prims.begin(), prims.end()}, options);
+    } else {
+        bvh = buildFromPrimitives(prims, options);
+    }
+    reserveOnHugePages(bvh.leafTriangles, bvh.primitiveIndices.size());
     for (uint32_t t : bvh.primitiveIndices)
         bvh.leafTriangles.push_back({mesh.vertex(t, 0), mesh.vertex(t, 1), mesh.vertex(t, 2)});
     finishStats(bvh, options, watch.milliseconds(), stats);

@@ -83,6 +83,7 @@ int runTrace(const TraceOptions& o) {
                         {"bins", o.bins},
                         {"repeat", o.repeat},
                         {"nodes", stats.nodes},
+                        {"references", bvh.primitiveIndices.size()},
                         {"depth", stats.depth},
                         {"sah_cost", stats.sahCost}};
     // --width 4 or 8: the traced tree's own figures; nodes, depth and SAH cost stay the
@@ -123,7 +124,9 @@ int runCheck(const CheckOptions& o) {
     double bruteSeconds = watch.seconds();
     nlohmann::json j = {{"mesh", o.mesh}, {"rays", rays.size()}, {"brute_force_s", bruteSeconds}};
     size_t total = 0;
-    for (BvhBuilder builder : kExerciseBuilders) {
+    // The exercises' builders, and the SAH with spatial splits (its leaves share triangles).
+    for (BvhBuilder builder : {BvhBuilder::Midpoint, BvhBuilder::Median, BvhBuilder::BinnedSah,
+                               BvhBuilder::SpatialSah}) {
         BvhBuildOptions build;
         build.builder = builder;
         Bvh bvh = buildBvh(mesh, build);
@@ -136,17 +139,19 @@ int runCheck(const CheckOptions& o) {
         }
         j[bvhBuilderName(builder)] = {{"differ", differ}, {"hits", hit}};
         total += differ;
-        if (builder == BvhBuilder::BinnedSah) {  // and its 4- and 8-wide collapses (bvh4.hpp)
+        // The SAH trees' 4- and 8-wide collapses (bvh4.hpp).
+        if (builder == BvhBuilder::BinnedSah || builder == BvhBuilder::SpatialSah) {
             auto countDiffering = [&] {
                 size_t n = 0;
                 for (size_t i = 0; i < rays.size(); ++i) n += !hitsAgree(hits[i], reference[i]);
                 total += n;
                 return n;
             };
+            std::string name = bvhBuilderName(builder);
             traceBatch(collapseToBvh4(bvh), rays, hits, o.threads);
-            j["sah-4wide"] = {{"differ", countDiffering()}};
+            j[name + "-4wide"] = {{"differ", countDiffering()}};
             traceBatch(collapseToBvh8(bvh), rays, hits, o.threads);
-            j["sah-8wide"] = {{"differ", countDiffering()}};
+            j[name + "-8wide"] = {{"differ", countDiffering()}};
         }
     }
     if (o.cracks > 0) {
@@ -178,7 +183,7 @@ int main(int argc, char** argv) {
         addCommonOptions(app, opts, "bunny");
         std::string builderName = "sah";
         app.add_option("--builder", builderName,
-                       "hierarchy builder: midpoint, median, sah, sweep-sah")
+                       "hierarchy builder: midpoint, median, sah, sweep-sah, sbvh")
             ->capture_default_str();
         int bins = 16;
         app.add_option("--bins", bins, "binned SAH: bins per axis")
@@ -203,8 +208,10 @@ int main(int argc, char** argv) {
         traceCommand
             ->add_option("--hits", trace.hits, "written: float32 t, uint32 triangle per ray")
             ->required();
-        traceCommand->add_option("--builder", trace.builder, "midpoint, median, sah or sweep-sah")
-            ->check(CLI::IsMember({"midpoint", "median", "sah", "sweep-sah"}))
+        traceCommand
+            ->add_option("--builder", trace.builder,
+                         "midpoint, median, sah, sweep-sah or sbvh (SAH with spatial splits)")
+            ->check(CLI::IsMember({"midpoint", "median", "sah", "sweep-sah", "sbvh"}))
             ->capture_default_str();
         traceCommand->add_option("--threads", trace.threads, "threads")
             ->check(CLI::Range(1, 256))

@@ -54,11 +54,11 @@ Table measureBuilds(const NamedMesh& mesh, int bins, int repeats) {
              std::to_string(bins) + " bins";
     BvhBuildStats sweep;
     buildBvh(*mesh.mesh, optionsFor(BvhBuilder::SweepSah, bins), &sweep);
-    for (BvhBuilder builder :
-         {BvhBuilder::Midpoint, BvhBuilder::Median, BvhBuilder::BinnedSah, BvhBuilder::SweepSah}) {
+    for (BvhBuilder builder : {BvhBuilder::Midpoint, BvhBuilder::Median, BvhBuilder::BinnedSah,
+                               BvhBuilder::SweepSah, BvhBuilder::SpatialSah}) {
         std::vector<double> ms;
         BvhBuildStats s;
-        int n = builder == BvhBuilder::SweepSah ? 1 : repeats;
+        int n = builder == BvhBuilder::SweepSah || builder == BvhBuilder::SpatialSah ? 1 : repeats;
         for (int i = 0; i < n; ++i) {
             buildBvh(*mesh.mesh, optionsFor(builder, bins), &s);
             ms.push_back(s.buildMs);
@@ -144,12 +144,19 @@ Table measureBvhCracks(const std::vector<NamedMesh>& meshes, size_t raysPerFeatu
         "over the first 200 rays per row against brute force";
     for (const NamedMesh& m : meshes) {
         CrackRaySet set = makeCrackRays(*m.mesh, raysPerFeature, raysPerFeature, seed);
-        // The exercise builders, then the binned SAH tree collapsed to 4- and 8-wide nodes
-        // (bvh4.hpp).
-        constexpr int kBuilders = int(std::size(kExerciseBuilders));
-        for (int variant = 0; variant < kBuilders + 2; ++variant) {
-            int width = variant < kBuilders ? 2 : variant == kBuilders ? 4 : 8;
-            BvhBuilder builder = width > 2 ? BvhBuilder::BinnedSah : kExerciseBuilders[variant];
+        // The exercise builders, the SAH with spatial splits (whose split planes cut
+        // triangles, edges and vertices included), then the binned SAH tree collapsed to 4-
+        // and 8-wide nodes (bvh4.hpp).
+        struct Variant {
+            BvhBuilder builder;
+            int width;
+        };
+        std::vector<Variant> variants;
+        for (BvhBuilder b : kExerciseBuilders) variants.push_back({b, 2});
+        variants.push_back({BvhBuilder::SpatialSah, 2});
+        variants.push_back({BvhBuilder::BinnedSah, 4});
+        variants.push_back({BvhBuilder::BinnedSah, 8});
+        for (auto [builder, width] : variants) {
             Bvh bvh = buildBvh(*m.mesh, optionsFor(builder, 16));
             Bvh4 bvh4 = width == 4 ? collapseToBvh4(bvh) : Bvh4{};
             Bvh8 bvh8 = width == 8 ? collapseToBvh8(bvh) : Bvh8{};

@@ -2,14 +2,16 @@
 """Step 04 beside Intel Embree: the same rays, back to back, one thread each.
 
 usage: tools/bench04.py [--rays N] [--repeat K] [--rounds R] [--meshes bunny,motorbike,oa_thor]
-                        [--kinds primary,diffuse,random] [--builders midpoint,median,sah,sah4,sah8]
+                        [--kinds primary,diffuse,random]
+                        [--builders midpoint,median,sah,sah4,sah8,sbvh,sbvh8]
                         [--no-extras] [--thread-rays N] [--thread-pairs P] [--quiet-wait S]
                         [--out out/04_bvh_bench.json] [--data DIR] [--program PATH]
 
 For every mesh and ray kind (primary, diffuse, random) it writes one ray set with
 peer-bench's make_rays.py, runs peer-bench (Embree 3, one thread) and then our
 `04_bvh trace` with each builder on that file (and "sah 4-wide", "sah 8-wide": the
-binned SAH tree collapsed to 4- or 8-wide nodes, `--width 4` or `--width 8`), each run
+binned SAH tree collapsed to 4- or 8-wide nodes, `--width 4` or `--width 8`; "sbvh" and
+"sbvh 8-wide": the binned SAH with spatial splits, not an exercise), each run
 --repeat passes (the programs report the median), all of it --rounds times, alternating;
 the ratios are the medians of the rounds' own ratios. Each round first waits (at most
 --quiet-wait s) until a short probe runs at 90% of its best speed: some minutes on a shared
@@ -179,7 +181,7 @@ def main():
                     help="runs of Embree and every builder, alternating (medians of the ratios)")
     ap.add_argument("--meshes", default="bunny,motorbike,oa_thor")
     ap.add_argument("--kinds", default="primary,diffuse,random")
-    ap.add_argument("--builders", default="midpoint,median,sah,sah4,sah8",
+    ap.add_argument("--builders", default="midpoint,median,sah,sah4,sah8,sbvh,sbvh8",
                     help="sah4, sah8: the binned SAH tree collapsed to 4- or 8-wide nodes (SIMD)")
     ap.add_argument("--no-extras", action="store_true",
                     help="skip the two-thread runs and the sweep-SAH quality reference")
@@ -220,7 +222,9 @@ def main():
                 ("median", "median", ["--builder", "median"]),
                 ("sah", "sah", ["--builder", "sah"]),
                 ("sah 4-wide", "sah4", ["--builder", "sah", "--width", "4"]),
-                ("sah 8-wide", "sah8", ["--builder", "sah", "--width", "8"]))
+                ("sah 8-wide", "sah8", ["--builder", "sah", "--width", "8"]),
+                ("sbvh", "sbvh", ["--builder", "sbvh"]),
+                ("sbvh 8-wide", "sbvh8", ["--builder", "sbvh", "--width", "8"]))
                 if key in a.builders.split(",")]
             ehits, ohits = os.path.join(work, "embree.bin"), os.path.join(work, "ours.bin")
             embree_runs, our_runs, agree = [], {b: [] for b, _ in variants}, {}
@@ -294,13 +298,25 @@ def main():
     def paired(a_row, b_row, key):  # two builders: the median of the rounds' own ratios
         return statistics.median(round_ratios(a_row["runs"], b_row["runs"], key))
 
-    print("\nBinned SAH against midpoint (primary rays; wall, CPU time; medians of the rounds):")
-    for mesh in a.meshes.split(","):
-        by = {r["builder"]: r for r in rows if r["mesh"] == mesh and r["kind"] == "primary"}
-        if "sah" not in by or "midpoint" not in by:
-            continue
-        print("  %-10s %.2fx  %.2fx" % (mesh, paired(by["sah"], by["midpoint"], "mrays_per_s"),
-                                        paired(by["sah"], by["midpoint"], "mrays_per_cpu_s")))
+    for sah in ("sah", "sbvh"):
+        print("\n%s against midpoint (primary rays; wall, CPU time; medians of the rounds):"
+              % ("Binned SAH" if sah == "sah" else "SAH with spatial splits"))
+        for mesh in a.meshes.split(","):
+            by = {r["builder"]: r for r in rows if r["mesh"] == mesh and r["kind"] == "primary"}
+            if sah not in by or "midpoint" not in by:
+                continue
+            print("  %-10s %.2fx  %.2fx" % (mesh, paired(by[sah], by["midpoint"], "mrays_per_s"),
+                                            paired(by[sah], by["midpoint"], "mrays_per_cpu_s")))
+    print("\nSpatial splits against the binned SAH (same width; wall, CPU time):")
+    for plain, split in (("sah", "sbvh"), ("sah 8-wide", "sbvh 8-wide")):
+        for mesh in a.meshes.split(","):
+            for kind in a.kinds.split(","):
+                by = {r["builder"]: r for r in rows if r["mesh"] == mesh and r["kind"] == kind}
+                if plain not in by or split not in by:
+                    continue
+                print("  %-11s %-10s %-8s %.2fx  %.2fx" % (
+                    split, mesh, kind, paired(by[split], by[plain], "mrays_per_s"),
+                    paired(by[split], by[plain], "mrays_per_cpu_s")))
     for wide in ("sah 4-wide", "sah 8-wide"):
         print("\n%s (SIMD) against the binary tree, binned SAH (wall, CPU time):" % wide[4:])
         for mesh in a.meshes.split(","):

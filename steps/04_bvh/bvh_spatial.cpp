@@ -154,8 +154,10 @@ private:
                 if (n <= leafLimit) return makeLeaf();
                 left = n / 2;
             }
-            leftRefs.assign(refs.begin(), refs.begin() + std::ptrdiff_t(left));
+            // The left child takes the node's own array (no copy, no new pages).
             rightRefs.assign(refs.begin() + std::ptrdiff_t(left), refs.end());
+            refs.resize(left);
+            leftRefs = std::move(refs);
         }
         refs = {};  // the children own the references now
         uint32_t leftChild = uint32_t(bvh_.nodes.size());
@@ -183,7 +185,8 @@ private:
             float lo = at(node.min, axis), hi = at(node.max, axis), width = (hi - lo) / float(bins);
             if (!(width > 0.0f) || !std::isfinite(width)) continue;
             auto plane = [&](int b) { return b == bins ? hi : lo + width * float(b); };
-            auto binOf = [&](float x) { return std::clamp(int((x - lo) / width), 0, bins - 1); };
+            float perWidth = 1.0f / width;  // bins only price planes: no exact division needed
+            auto binOf = [&](float x) { return std::clamp(int((x - lo) * perWidth), 0, bins - 1); };
             std::fill(binBounds.begin(), binBounds.end(), Bounds3f());
             std::fill(entries.begin(), entries.end(), 0u);
             std::fill(exits.begin(), exits.end(), 0u);

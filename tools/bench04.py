@@ -142,17 +142,19 @@ def agreement(ours, theirs):
     return same / max(1, len(ours))
 
 
-def measure_threads(a, peer, obj, mesh, kind, work):
+def measure_threads(a, peer, obj, mesh, kind, work, gate):
     """Two threads against one on a larger ray set (--thread-rays: a pass must last long
     enough that starting the threads and the scheduler's noise do not count), in alternating
-    pairs, ours (binned SAH) and Embree's; the medians of the pairs' speed-ups. Embree's own
-    scaling on the same rays is what this machine's two cores allow."""
+    pairs, ours (binned SAH) and Embree's; the medians of the pairs' speed-ups. Each pair
+    waits for a quiet minute first, as the rounds do. Embree's speed-up beside ours is not
+    the machine's ceiling: peer-bench starts its threads for every pass."""
     rays = os.path.join(work, "%s-%s-threads.bin" % (mesh, kind))
     extra = INSIDE if (mesh == "oa_thor" and kind == "primary") else []
     make_rays(os.path.dirname(peer), obj, kind, a.thread_rays, rays, ["--seed", "7"] + extra)
     hits = os.path.join(work, "threads-hits.bin")
     speed = {"ours": {1: [], 2: []}, "embree": {1: [], 2: []}}
     for _ in range(a.thread_pairs):
+        gate.wait()
         for n in (1, 2):
             speed["ours"][n].append(run_json(
                 [a.program, "trace", "--mesh", obj, "--rays", rays, "--hits", hits, "--threads",
@@ -187,7 +189,7 @@ def main():
                     help="skip the two-thread runs and the sweep-SAH quality reference")
     ap.add_argument("--thread-rays", type=int, default=500000,
                     help="rays per set for the two-thread row (primary and diffuse)")
-    ap.add_argument("--thread-pairs", type=int, default=3,
+    ap.add_argument("--thread-pairs", type=int, default=5,
                     help="alternating 1-thread/2-thread pairs for the two-thread row")
     ap.add_argument("--data", default="/work/shared/data/meshes")
     ap.add_argument("--out", default=os.path.join(ROOT, "out", "04_bvh_bench.json"))
@@ -268,7 +270,7 @@ def main():
                          ratios[-1], row["cpu_ratio"], row["build_ms"], row["sah_cost"],
                          row["agree_with_embree"]), file=sys.stderr)
             if kind in ("primary", "diffuse") and not a.no_extras:
-                threads.append(measure_threads(a, peer, obj, mesh, kind, work))
+                threads.append(measure_threads(a, peer, obj, mesh, kind, work, gate))
             if sweep is None and not a.no_extras:
                 sweep = run_json([a.program, "trace", "--mesh", obj, "--rays", rays, "--hits", ohits,
                                   "--builder", "sweep-sah"])

@@ -2,7 +2,7 @@
 # Fuzzes every target (or the ones named) for SECONDS each, one after the other, with
 # clang's libFuzzer under ASan+UBSan, at the lowest CPU priority.
 # usage: tools/fuzz.sh SECONDS [TARGET...]
-#        (targets: obj flags vec3 scene rays exam_answer results; results is Python)
+#        (targets: obj flags vec3 scene rays sbvh exam_answer results; results is Python)
 # Seeds come from fuzz/corpus/TARGET/ (committed). New coverage goes to build/fuzz/work/
 # TARGET/ (not committed); every crashing, leaking or hanging input found is copied into
 # fuzz/corpus/TARGET/ so the replay test (ctest -L fuzz-replay) keeps it: commit it with
@@ -14,7 +14,7 @@ cd "$(dirname "$0")/.."
 seconds=$1
 shift
 targets=("$@")
-[[ ${#targets[@]} -gt 0 ]] || targets=(obj flags vec3 scene rays exam_answer results)
+[[ ${#targets[@]} -gt 0 ]] || targets=(obj flags vec3 scene rays sbvh exam_answer results)
 
 tools/deps.sh build fuzz
 cmake --preset fuzz >/dev/null

@@ -186,7 +186,12 @@ private:
             if (!(width > 0.0f) || !std::isfinite(width)) continue;
             auto plane = [&](int b) { return b == bins ? hi : lo + width * float(b); };
             float perWidth = 1.0f / width;  // bins only price planes: no exact division needed
-            auto binOf = [&](float x) { return std::clamp(int((x - lo) * perWidth), 0, bins - 1); };
+            // Clamped in float before the conversion: a subnormal width makes perWidth
+            // infinite, and 0 * infinity a NaN (fuzz_sbvh found it); NaN goes to bin 0.
+            auto binOf = [&](float x) {
+                float f = (x - lo) * perWidth;
+                return f >= float(bins - 1) ? bins - 1 : f > 0.0f ? int(f) : 0;
+            };
             std::fill(binBounds.begin(), binBounds.end(), Bounds3f());
             std::fill(entries.begin(), entries.end(), 0u);
             std::fill(exits.begin(), exits.end(), 0u);

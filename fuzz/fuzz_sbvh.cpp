@@ -79,7 +79,8 @@ extern "C" int LLVMFuzzerTestOneInput(const uint8_t* data, size_t size) {
         for (float x : v) finite = finite && std::isfinite(x);
         if (!finite) continue;
         uint32_t n = uint32_t(mesh.positions.size());
-        for (int k = 0; k < 3; ++k) mesh.positions.emplace_back(v[3 * k], v[3 * k + 1], v[3 * k + 2]);
+        for (int k = 0; k < 3; ++k)
+            mesh.positions.emplace_back(v[3 * k], v[3 * k + 1], v[3 * k + 2]);
         mesh.triangles.push_back({n, n + 1, n + 2});
     }
     if (mesh.triangles.empty()) return 0;
@@ -100,8 +101,8 @@ extern "C" int LLVMFuzzerTestOneInput(const uint8_t* data, size_t size) {
     for (size_t t = 0; t < triangles; ++t) {
         if (boxes[t].empty()) fuzz::fail("a triangle in no leaf");
         Vec3d a(mesh.vertex(t, 0)), b(mesh.vertex(t, 1)), c(mesh.vertex(t, 2));
-        for (const Vec3d& p : {a, b, c, 0.5 * (a + b), 0.5 * (b + c), 0.5 * (c + a),
-                               (a + b + c) / 3.0}) {
+        for (const Vec3d& p :
+             {a, b, c, 0.5 * (a + b), 0.5 * (b + c), 0.5 * (c + a), (a + b + c) / 3.0}) {
             bool covered = false;
             for (const Bounds3f& box : boxes[t]) covered = covered || inside(p, box);
             if (!covered) fuzz::fail("a point of a triangle outside every leaf box of it");

@@ -120,7 +120,7 @@ TEST_SUITE("core") {
         t.print(out);
         CHECK(out.str().find("bb") != std::string::npos);
     }
-    TEST_CASE("threads: every thread index once, thread 0 the caller, workers kept") {
+    TEST_CASE("threads: every thread index once with thread 0 the caller and kept workers") {
         // The kept workers grow, shrink and are reused between the calls.
         for (int threads : {1, 2, 3, 4, 2, 2, 0}) {
             INFO("threads " << threads);
@@ -159,7 +159,7 @@ TEST_SUITE("core") {
         }
     }
     TEST_CASE(
-        "threads: parallelRows runs every row once; an exception stops it and reaches "
+        "threads: parallelRows runs every row once and an exception stops it and reaches "
         "the caller") {
         for (int threads : {1, 2, 3}) {
             INFO("threads " << threads);

@@ -182,7 +182,8 @@ TEST_SUITE("exercise 6.3") {
         CHECK(out.vertices[3].position.w == 1.0);
     }
     TEST_CASE(
-        "one vertex inside: a smaller triangle; all inside: unchanged; all outside: nothing") {
+        "one vertex inside gives a smaller triangle while all inside stays and all outside "
+        "goes") {
         ClipPolygon one =
             clipAgainstPlane(triangle({0, 0, 0, 1}, {0, 0, -3, 1}, {1, 0, -3, 1}), kClipNearPlane);
         REQUIRE(one.count == 3);

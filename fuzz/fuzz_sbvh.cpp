@@ -62,9 +62,10 @@ bool inside(const Vec3d& p, const Bounds3f& box) {
 
 // The hierarchy promises brute force's hit when the leaf test's hit point lies within the
 // triangle's box widened by the traversal margin (the leaf test's error bound for a
-// triangle with area). For a zero-area or needle triangle the float leaf test's t can be
-// noise far beyond that (step 04's README, "What is left"); then no box test can promise
-// the same answer, and the ray is skipped.
+// triangle with area). For a needle below the float resolution at the ray origin the leaf
+// test's t can be noise far beyond that (step 04's README, "What is left"); then no box
+// test can promise the same answer, and the ray is skipped. (Zero-area triangles are
+// never hit: leafTriangleOf.)
 bool trustworthy(const Mesh& mesh, const Ray& ray, const TraceHit& hit, float margin) {
     if (hit.triangle == kNoPrimitive) return true;
     Vec3d o(ray.origin), d(ray.direction);

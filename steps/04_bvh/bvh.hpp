@@ -47,6 +47,16 @@ struct LeafTriangle {
     Vec3 a, b, c;
 };
 
+// The leaf-test copy of a mesh's triangle. A triangle without area (the cross product of
+// its edge vectors exactly zero in double: a repeated vertex, or three on one line) is
+// stored as its first vertex three times, which the watertight test misses for every ray
+// (its edge functions and det are exactly 0), at no cost in the hot loop. pbrt-v4's
+// IntersectTriangle rejects such triangles too: their edge functions are rounding noise,
+// and so is a t computed from them (rays aimed within 1e-7 of a segment on the y axis hit
+// it 3.7% of the time, up to 0.62 off the axis: outside the triangle's box, where a
+// hierarchy and brute force then differ).
+LeafTriangle leafTriangleOf(const Mesh& mesh, size_t triangle);
+
 // Memory for large arrays (bvh_build.cpp): at least 64-byte aligned; from half a megabyte
 // on, 2 MiB aligned and on transparent huge pages where Linux offers them (far fewer page
 // faults while the build fills it, fewer TLB misses while tracing).

@@ -483,10 +483,16 @@ Bvh buildBvh(const Mesh& mesh, const BvhBuildOptions& options, BvhBuildStats* st
         bvh = buildFromPrimitives(prims, options);
     }
     reserveOnHugePages(bvh.leafTriangles, bvh.primitiveIndices.size());
-    for (uint32_t t : bvh.primitiveIndices)
-        bvh.leafTriangles.push_back({mesh.vertex(t, 0), mesh.vertex(t, 1), mesh.vertex(t, 2)});
+    for (uint32_t t : bvh.primitiveIndices) bvh.leafTriangles.push_back(leafTriangleOf(mesh, t));
     finishStats(bvh, options, watch.milliseconds(), stats);
     return bvh;
+}
+
+LeafTriangle leafTriangleOf(const Mesh& mesh, size_t triangle) {
+    Vec3 a = mesh.vertex(triangle, 0), b = mesh.vertex(triangle, 1), c = mesh.vertex(triangle, 2);
+    Vec3d normal = glm::cross(Vec3d(b) - Vec3d(a), Vec3d(c) - Vec3d(a));
+    if (normal == Vec3d(0.0)) return {a, a, a};
+    return {a, b, c};
 }
 
 double bvhSahCost(const Bvh& bvh, float traversalCost, float intersectionCost) {

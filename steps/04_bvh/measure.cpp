@@ -170,8 +170,7 @@ Table measureBvhCracks(const std::vector<NamedMesh>& meshes, size_t raysPerFeatu
                     float target = kInfinity<float>;
                     WatertightRay w(cr.ray);
                     for (uint32_t tri : cr.triangles) {
-                        LeafTriangle lt{m.mesh->vertex(tri, 0), m.mesh->vertex(tri, 1),
-                                        m.mesh->vertex(tri, 2)};
+                        LeafTriangle lt = leafTriangleOf(*m.mesh, tri);
                         float tmax = cr.ray.tmax;
                         if (intersectLeafTriangle(w, lt, tmax)) target = std::min(target, tmax);
                     }

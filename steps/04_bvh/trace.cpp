@@ -19,7 +19,7 @@ TraceHit traceBruteForce(const Mesh& mesh, const Ray& ray) {
     float tClosest = ray.tmax;
     withWatertightAxes(watertight, [&](auto axes) {
         for (size_t i = 0; i < mesh.triangles.size(); ++i) {
-            LeafTriangle tri{mesh.vertex(i, 0), mesh.vertex(i, 1), mesh.vertex(i, 2)};
+            LeafTriangle tri = leafTriangleOf(mesh, i);
             float t = tClosest;
             // Strictly nearer only: the first of equally near triangles stays.
             if (intersectLeafTriangle(axes, watertight, tri, t) &&
@@ -145,8 +145,7 @@ void traceBatchBruteForce(const Mesh& mesh, const std::vector<Ray>& rays,
     constexpr size_t kTriangleBlock = 2048;
     size_t triangleCount = mesh.triangles.size();
     std::vector<LeafTriangle> triangles(triangleCount);
-    for (size_t i = 0; i < triangleCount; ++i)
-        triangles[i] = {mesh.vertex(i, 0), mesh.vertex(i, 1), mesh.vertex(i, 2)};
+    for (size_t i = 0; i < triangleCount; ++i) triangles[i] = leafTriangleOf(mesh, i);
     forEachRayChunk(rays.size(), threads, [&](size_t begin, size_t end) {
         std::vector<WatertightRay> prepared;
         std::vector<float> tClosest;

@@ -205,7 +205,8 @@ inline bool traceOccluded(const Bvh& bvh, const Ray& ray) {
     });
 }
 
-// Every triangle, in file order; the first of equally near triangles wins.
+// Every triangle, in file order (as leafTriangleOf stores it: one without area is never
+// hit); the first of equally near triangles wins.
 TraceHit traceBruteForce(const Mesh& mesh, const Ray& ray);
 
 // RAYS.bin: float32 ox oy oz tmin dx dy dz tmax per ray (little-endian).

@@ -346,6 +346,20 @@ def main():
           "absolute figures drift with the load; %.0f s spent waiting for quiet minutes)"
           % (load, os.cpu_count(), gate.waited))
     os.makedirs(os.path.dirname(os.path.abspath(a.out)), exist_ok=True)
+    # The ratios at a glance (the report's and the deck's summary): builders down, ray sets
+    # across.
+    sets = [(m, k) for m in a.meshes.split(",") for k in a.kinds.split(",")
+            if any(r["mesh"] == m and r["kind"] == k for r in rows)]
+    builders = list(dict.fromkeys(r["builder"] for r in rows))
+    ratio_of = {(r["builder"], r["mesh"], r["kind"]): round(r["ratio"], 2) for r in rows}
+    ratios_table = {
+        "id": "bench04_ratios", "title": "Rays per second against Embree's (one thread each)",
+        "columns": ["builder"] + ["%s %s" % (m, k) for m, k in sets],
+        "rows": [[b] + [ratio_of.get((b, m, k)) for m, k in sets] for b in builders],
+        "note": "Per cell the median of the rounds' ratios (%d rounds; the Mrays/s are in "
+                "bench04_embree). Issue 5's targets: binned SAH ('sah') at least 0.6 on "
+                "primary and 0.35 on diffuse rays; the stretch goal a 4-wide tree at 1.0"
+                % a.rounds}
     cpu = "unknown CPU"
     try:
         cpu = [l.split(":", 1)[1].strip() for l in open("/proc/cpuinfo")
@@ -355,6 +369,7 @@ def main():
     report = {"program": "04_bvh_bench", "images": [],
               "machine": "%s, %d cores, load average %.1f" % (cpu, os.cpu_count(), load), "facts": {"load_average": os.getloadavg()[0]}, "rays": a.rays, "repeat": a.repeat, "load_average": load, "quiet_wait_s": gate.waited,
               "tables": [
+                  ratios_table,
                   {"id": "bench04_embree", "title": "Step 04 beside Embree 3: one thread each",
                    "columns": ["mesh", "rays", "builder", "Mrays/s", "Embree Mrays/s", "ratio",
                                "CPU ratio", "build ms", "SAH cost", "agree"],

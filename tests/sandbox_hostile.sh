@@ -29,6 +29,11 @@ build spew '#include <cstdio>
 int main() { FILE* f = std::fopen("big.txt", "w"); char b[65536] = {1}; for (;;) std::fwrite(b, 1, sizeof b, f); }'
 build escape '#include <cstdio>
 int main(int, char** argv) { FILE* f = std::fopen(argv[1], "w"); if (!f) return 5; std::fputs("pwned", f); std::fclose(f); return 0; }'
+# Forks until fork fails (children wait), then exits 7 with the count; 0 past 5,000 (no limit).
+build forks '#include <cstdio>
+#include <unistd.h>
+int main() { for (int n = 0;; ++n) { pid_t p = fork(); if (p == 0) { pause(); _exit(0); }
+  if (p < 0) { std::printf("%d\n", n); return 7; } if (n >= 5000) return 0; } }'
 build net '#include <arpa/inet.h>
 #include <sys/socket.h>
 #include <unistd.h>
@@ -45,6 +50,9 @@ expect "failed: exit 5" escape-home -- "$work/escape" "$root/pwned.txt"
 expect "failed: exit 6" net -- "$work/net"
 expect "ok" inside -- "$work/escape" inside.txt
 expect "output limit" flood --output 1 -- yes flood
+expect "failed: exit 7" forks --processes 64 -- "$work/forks"
+forked=$(cat "$work/box-forks/stdout.txt" 2>/dev/null)
+[[ $forked =~ ^[0-9]+$ && $forked -le 64 ]] || { echo "FAIL: the fork bomb forked '$forked' times under --processes 64"; failures=$((failures + 1)); }
 # Even when the grader runs as root the sandbox has no capabilities: it cannot lift its limits.
 expect "failed: exit 4" lift -- sh -c 'prlimit --cpu=unlimited:unlimited --pid $$ || exit 4'
 [[ $(cat "$outside") == untouched ]] || { echo "FAIL: a file outside the sandbox changed"; failures=$((failures + 1)); }

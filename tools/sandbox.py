@@ -2,7 +2,7 @@
 """Runs one untrusted command isolated and limited: the grader's student builds and test
 runs (tools/grade.py imports this module), and tools/sandbox.sh on the command line.
 
-usage: tools/sandbox.py [--time S] [--memory MB] [--output MB] [--dir DIR]
+usage: tools/sandbox.py [--time S] [--memory MB] [--output MB] [--processes N] [--dir DIR]
                         [--no-isolation] -- COMMAND [ARGS...]
 
 Isolation (bubblewrap): the whole system read-only, DIR (default: a fresh temporary folder)
@@ -12,7 +12,9 @@ and no further user namespaces (even when the grader runs as root), killed with 
 Limits (setrlimit, inherited by every process the command starts): wall-clock seconds (the
 whole run), CPU seconds (per process: the wall time times the cores, so a busy loop in
 every thread still stops), address space per process, the size of any file written, and
-the bytes the command prints on stdout and stderr together.
+the bytes the command prints on stdout and stderr together. The number of processes and
+threads (a fork bomb): as root a pids cgroup of its own (the kernel does not apply
+RLIMIT_NPROC to root), else RLIMIT_NPROC above the user's current count.
 
 On the command line the command's stdout and stderr go to DIR/stdout.txt and
 DIR/stderr.txt (their first bytes, up to the output limit) and one line
@@ -22,6 +24,7 @@ or refused (bubblewrap cannot create namespaces here and no --no-isolation).
 Environment: BOXES_BWRAP names the bubblewrap program (default: bwrap on PATH).
 """
 import argparse
+import itertools
 import os
 import resource
 import selectors
@@ -45,6 +48,7 @@ class Limits:
     memory_mb: int = 1024  # address space of each process
     output_mb: float = 16.0  # stdout + stderr together, and any one file written
     file_mb: float = 0.0  # any one file written, when it must differ from output_mb (a build)
+    processes: int = 256  # processes and threads the command may have at once
 
     def cpu_seconds(self):
         return int(self.seconds * (os.cpu_count() or 1)) + 1
@@ -113,8 +117,130 @@ def bwrap_prefix(writable, cwd, tmp_bytes, hidden=(), readable=()):
     return prefix + ["--chdir", cwd] + _namespaces()
 
 
-def _set_limits(limits):
+def _user_tasks(uid):
+    """Threads of all processes whose real user is uid (what RLIMIT_NPROC counts)."""
+    count = 0
+    for entry in os.listdir("/proc"):
+        if not entry.isdigit():
+            continue
+        try:
+            with open(f"/proc/{entry}/status") as f:
+                fields = dict(line.split(":", 1) for line in f if ":" in line)
+            if int(fields["Uid"].split()[0]) == uid:
+                count += int(fields["Threads"])
+        except (OSError, KeyError, ValueError):
+            pass  # gone meanwhile
+    return count
+
+
+def _pids_hierarchies():
+    """Where a new pids cgroup can go: the cgroup v2 root when its pids controller is
+    enabled for children, then cgroup v1's pids hierarchy."""
+    v2, v1 = [], []
+    try:
+        with open("/proc/self/mounts") as f:
+            for line in f:
+                parts = line.split()
+                if len(parts) >= 4 and parts[2] == "cgroup2":
+                    v2.append(parts[1])
+                elif len(parts) >= 4 and parts[2] == "cgroup" and "pids" in parts[3].split(","):
+                    v1.append(parts[1])
+    except OSError:
+        return []
+    usable = []
+    for mount in v2:
+        try:
+            with open(os.path.join(mount, "cgroup.subtree_control")) as f:
+                if "pids" in f.read().split():
+                    usable.append(mount)
+        except OSError:
+            pass
+    return usable + v1
+
+
+_cgroup_serial = itertools.count(1)  # next() is atomic: the grader runs jobs on threads
+_stale_check = itertools.count(0)  # stale cgroups are looked for once per grader
+
+
+def _remove_stale_cgroups(hierarchy):
+    # Left by a grader that was killed: the empty cgroups of processes that are gone.
+    try:
+        names = os.listdir(hierarchy)
+    except OSError:
+        return
+    for name in names:
+        parts = name.split("-")
+        if len(parts) != 4 or parts[:2] != ["boxes", "sandbox"] or not parts[2].isdigit():
+            continue
+        try:
+            os.kill(int(parts[2]), 0)
+            continue  # its grader still runs
+        except ProcessLookupError:
+            pass
+        except OSError:
+            continue
+        try:
+            os.rmdir(os.path.join(hierarchy, name))
+        except OSError:
+            pass  # tasks still in it
+
+
+def _make_pids_cgroup(limit):
+    """As root: a new cgroup of at most `limit` tasks; its folder, or None where no pids
+    controller can be written."""
+    for hierarchy in _pids_hierarchies():
+        if next(_stale_check) == 0:
+            _remove_stale_cgroups(hierarchy)
+        serial = next(_cgroup_serial)
+        folder = os.path.join(hierarchy, f"boxes-sandbox-{os.getpid()}-{serial}")
+        try:
+            os.mkdir(folder)
+        except OSError:
+            continue
+        try:
+            with open(os.path.join(folder, "pids.max"), "w") as f:
+                f.write(str(limit))
+            return folder
+        except OSError:
+            _remove_cgroup(folder)
+    return None
+
+
+def _remove_cgroup(folder):
+    # Its tasks were killed with the sandbox; the kernel may take a moment to reap them.
+    for _ in range(50):
+        try:
+            os.rmdir(folder)
+            return
+        except FileNotFoundError:
+            return
+        except OSError:
+            time.sleep(0.05)
+
+
+_warned_no_pids = False
+
+
+def _process_limit(limits):
+    """(cgroup folder or None, RLIMIT_NPROC value or None) for a run."""
+    global _warned_no_pids
+    if os.geteuid() != 0:
+        return None, _user_tasks(os.getuid()) + limits.processes
+    folder = _make_pids_cgroup(limits.processes)
+    if folder is None and not _warned_no_pids:
+        _warned_no_pids = True
+        print("sandbox: WARNING: running as root without a writable pids cgroup: the number "
+              "of processes is not limited", file=sys.stderr)
+    return folder, None
+
+
+def _set_limits(limits, cgroup=None, nproc=None):
     def apply():
+        if cgroup:  # first: every process the command starts stays in it
+            with open(os.path.join(cgroup, "cgroup.procs"), "w") as f:
+                f.write(str(os.getpid()))
+        if nproc is not None:
+            resource.setrlimit(resource.RLIMIT_NPROC, (nproc, nproc))
         cpu = limits.cpu_seconds()
         file_bytes = int((limits.file_mb or limits.output_mb) * (1 << 20))
         resource.setrlimit(resource.RLIMIT_CPU, (cpu, cpu + 1))  # SIGXCPU, then SIGKILL
@@ -145,13 +271,22 @@ def run(cmd, limits, writable=(), cwd=None, isolate=True, keep=1 << 20, env=None
     full = list(cmd)
     if isolate:
         full = bwrap_prefix(writable or [cwd], cwd, output_bytes, hidden, readable) + ["--"] + full
+    cgroup, nproc = _process_limit(limits)
+    try:
+        return _run_limited(full, limits, cwd, isolate, keep, env, output_bytes, cgroup, nproc)
+    finally:
+        if cgroup:
+            _remove_cgroup(cgroup)
+
+
+def _run_limited(full, limits, cwd, isolate, keep, env, output_bytes, cgroup, nproc):
     started = time.monotonic()
     try:
         p = subprocess.Popen(full, cwd=cwd, stdin=subprocess.DEVNULL, stdout=subprocess.PIPE,
                              stderr=subprocess.PIPE, start_new_session=True, env=env,
-                             preexec_fn=_set_limits(limits))
-    except OSError as e:
-        return Result("failed", f"failed: cannot start ({e.strerror})", 127, b"", str(e).encode(), 0.0)
+                             preexec_fn=_set_limits(limits, cgroup, nproc))
+    except (OSError, subprocess.SubprocessError) as e:
+        return Result("failed", f"failed: cannot start ({e})", 127, b"", str(e).encode(), 0.0)
     out, err = bytearray(), bytearray()
     printed, stopped = 0, ""
     sel = selectors.DefaultSelector()
@@ -231,6 +366,8 @@ def main(argv):
     p.add_argument("--time", type=float, default=10.0, help="wall-clock seconds (default 10)")
     p.add_argument("--memory", type=int, default=1024, help="address space in MB per process (default 1024)")
     p.add_argument("--output", type=float, default=16.0, help="MB printed, and per file written (default 16)")
+    p.add_argument("--processes", type=int, default=256,
+                   help="processes and threads at once (default 256)")
     p.add_argument("--dir", help="the writable working folder (default: a new temporary one)")
     p.add_argument("--no-isolation", action="store_true", help="limits only, no bubblewrap (trusted code)")
     p.add_argument("command", nargs=argparse.REMAINDER)
@@ -240,8 +377,9 @@ def main(argv):
         p.print_usage(sys.stderr)
         print("sandbox: no command given", file=sys.stderr)
         return 2
-    if args.time <= 0 or args.memory <= 0 or args.output <= 0:
-        print("sandbox: --time, --memory and --output must be positive", file=sys.stderr)
+    if args.time <= 0 or args.memory <= 0 or args.output <= 0 or args.processes <= 0:
+        print("sandbox: --time, --memory, --output and --processes must be positive",
+              file=sys.stderr)
         return 2
     if args.no_isolation:
         print("sandbox: WARNING: running without isolation (--no-isolation)", file=sys.stderr)
@@ -253,7 +391,8 @@ def main(argv):
             return 2
     folder = args.dir or tempfile.mkdtemp(prefix="boxes-sandbox-")
     os.makedirs(folder, exist_ok=True)
-    r = run(cmd, Limits(args.time, args.memory, args.output), writable=[folder],
+    r = run(cmd, Limits(args.time, args.memory, args.output, processes=args.processes),
+            writable=[folder],
             isolate=not args.no_isolation, keep=int(args.output * (1 << 20)))
     for name, data in (("stdout.txt", r.stdout), ("stderr.txt", r.stderr)):
         with open(os.path.join(folder, name), "wb") as f:

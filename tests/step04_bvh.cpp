@@ -1577,6 +1577,32 @@ TEST_SUITE("spatial splits 04") {
         }
         CHECK(differ == 0);
     }
+    TEST_CASE("sbvh: culling returns each kept triangle once") {
+        // A triangle cut by spatial splits sits in several leaves; a rasterizer must not
+        // draw it twice. The room seen through the hand-made frustum (as "culling 04").
+        Mesh m = room(30, 1000, 41);
+        for (Vec3& p : m.positions) p = p * 200.0f - Vec3(100.0f, 100.0f, 150.0f);
+        Bvh bvh = buildBvh(m, sbvhOptions());
+        REQUIRE(bvh.primitiveIndices.size() > m.triangleCount());
+        Frustum f = handFrustum();
+        for (CullTest test : {CullTest::Planes, CullTest::PlanesAndCorners}) {
+            CullCounts counts;
+            std::vector<uint32_t> visible = cullHierarchy(bvh, f, test, &counts);
+            std::set<uint32_t> kept(visible.begin(), visible.end());
+            CHECK(kept.size() == visible.size());
+            CHECK(counts.keptTriangles == visible.size());
+            CHECK(kept.size() < m.triangleCount());
+            size_t inside = 0;
+            for (size_t i = 0; i < m.triangleCount(); ++i) {
+                Bounds3f b;
+                for (int k = 0; k < 3; ++k) b.extend(m.vertex(i, k));
+                if (!boxIntersectsFrustumExact(f, b)) continue;
+                ++inside;
+                CHECK(kept.count(uint32_t(i)) == 1);
+            }
+            CHECK(inside > 100);
+        }
+    }
     TEST_CASE("sbvh: bounds without triangles build the binned SAH tree") {
         Mesh m = slivers(100, 45);
         BvhBuildOptions plain = sbvhOptions();

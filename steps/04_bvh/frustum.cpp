@@ -123,6 +123,7 @@ std::vector<uint32_t> cullHierarchy(const Bvh& bvh, const Frustum& frustum, Cull
     std::vector<uint32_t> visible;
     if (bvh.empty()) return visible;
     CullCounts local;
+    std::vector<bool> seen(bvh.primitiveIndices.size(), false);
     std::vector<uint32_t> stack = {0};
     while (!stack.empty()) {
         const BvhNode& node = bvh.nodes[stack.back()];
@@ -136,14 +137,19 @@ std::vector<uint32_t> cullHierarchy(const Bvh& bvh, const Frustum& frustum, Cull
         if (counts && !boxIntersectsFrustumExact(frustum, node.bounds())) ++local.wronglyKept;
         if (node.isLeaf()) {
             ++local.keptLeaves;
-            local.keptTriangles += node.count;
-            for (uint32_t s = node.leftFirst; s < node.leftFirst + node.count; ++s)
-                visible.push_back(bvh.primitiveIndices[s]);
+            for (uint32_t s = node.leftFirst; s < node.leftFirst + node.count; ++s) {
+                uint32_t triangle = bvh.primitiveIndices[s];
+                if (triangle >= seen.size()) seen.resize(size_t(triangle) + 1, false);
+                if (seen[triangle]) continue;  // already kept through another leaf
+                seen[triangle] = true;
+                visible.push_back(triangle);
+            }
         } else {
             stack.push_back(node.leftFirst + 1);
             stack.push_back(node.leftFirst);
         }
     }
+    local.keptTriangles = visible.size();
     if (counts) *counts = local;
     return visible;
 }

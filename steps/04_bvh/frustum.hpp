@@ -60,12 +60,13 @@ struct CullCounts {
     size_t culled = 0;       // boxes the test culled (their subtrees are skipped)
     size_t kept = 0;         // boxes the test kept
     size_t wronglyKept = 0;  // kept, yet entirely outside the frustum (exact test)
-    size_t keptLeaves = 0, keptTriangles = 0;
+    size_t keptLeaves = 0, keptTriangles = 0;  // triangles: distinct ones
 };
 
 // Walks the hierarchy from the root, skipping the subtree of every culled box, and
 // returns the primitives (triangle indices in file order) of the leaves it keeps: what a
-// rasterizer draws. With `counts`, also classifies every kept box with the exact test.
+// rasterizer draws, each once (leaves of a tree with spatial splits share triangles), in
+// the order first met. With `counts`, also classifies every kept box with the exact test.
 std::vector<uint32_t> cullHierarchy(const Bvh& bvh, const Frustum& frustum, CullTest test,
                                     CullCounts* counts = nullptr);
 

@@ -4,6 +4,7 @@
 #include <SDL2/SDL_keycode.h>
 #include <imgui.h>
 
+#include <algorithm>
 #include <cstdio>
 #include <ctime>
 #include <iostream>
@@ -339,14 +340,20 @@ int main(int argc, char** argv) {
         double renderMs = 0.0;
         CullCounts planeCounts, cornerCounts;
         WindowCallbacks cb;
-        cb.keys = {{SDLK_b, "next builder (midpoint / median / binned SAH), rebuilds"},
-                   {SDLK_c, "culling test: planes / planes + frustum corners"},
-                   {SDLK_l, "show deeper boxes in the map"},
-                   {SDLK_k, "show shallower boxes in the map"},
-                   {SDLK_f, "far plane: through the target / 3x further"}};
+        cb.keys = {
+            {SDLK_b, "next builder (midpoint / median / binned SAH / spatial splits), rebuilds"},
+            {SDLK_c, "culling test: planes / planes + frustum corners"},
+            {SDLK_l, "show deeper boxes in the map"},
+            {SDLK_k, "show shallower boxes in the map"},
+            {SDLK_f, "far plane: through the target / 3x further"}};
         cb.onKey = [&](int key) {
             if (key == SDLK_b && geometry) {
-                buildOptions.builder = BvhBuilder((int(buildOptions.builder) + 1) % 3);
+                constexpr BvhBuilder cycle[] = {BvhBuilder::Midpoint, BvhBuilder::Median,
+                                                BvhBuilder::BinnedSah, BvhBuilder::SpatialSah};
+                const BvhBuilder* at =
+                    std::find(std::begin(cycle), std::end(cycle), buildOptions.builder);
+                bool last = at == std::end(cycle) || at + 1 == std::end(cycle);
+                buildOptions.builder = last ? cycle[0] : at[1];
                 scene.geometries.clear();
                 geometry =
                     std::make_shared<MeshBvhGeometry>(scene.mesh, scene.meshMaterial, buildOptions);

@@ -1404,6 +1404,27 @@ TEST_SUITE("bvh 4-wide") {
                 CHECK(std::memcmp(fast2.data(), fast4.data(), rays.size() * sizeof(TraceHit)) == 0);
             }
         }
+        // Rays at shared edges and vertices: exact ties between neighbours and lanes for the
+        // scalar test, where the AVX2 loop's eight-lane leaf test (two packets at once)
+        // must still choose as the four-lane one does, packet by packet.
+        Mesh sh1 = loadObj(test::dataDir() + "/meshes/sh1.obj");
+        CrackRaySet set = makeCrackRays(sh1, 1500, 1500, 53);
+        std::vector<Ray> rays;
+        for (const auto* group : {&set.edgeRays, &set.vertexRays})
+            for (const CrackRay& cr : *group) rays.push_back(cr.ray);
+        Bvh binary = buildBvh(sh1, BvhBuildOptions{});
+        Bvh4 wide = collapseToBvh4(binary);
+        Bvh8 wide8 = collapseToBvh8(binary);
+        std::vector<TraceHit> fast4, fast8, base4, base8;
+        traceBatch(wide, rays, fast4, 1);
+        traceBatch(wide8, rays, fast8, 1);
+        setenv("BOXES_NO_AVX2", "1", 1);
+        traceBatch(wide, rays, base4, 1);
+        traceBatch(wide8, rays, base8, 1);
+        unsetenv("BOXES_NO_AVX2");
+        CHECK(rays.size() > 2000);
+        CHECK(std::memcmp(fast4.data(), base4.data(), rays.size() * sizeof(TraceHit)) == 0);
+        CHECK(std::memcmp(fast8.data(), base8.data(), rays.size() * sizeof(TraceHit)) == 0);
     }
 }
 

@@ -216,6 +216,20 @@ Frustum handFrustum() {
     return f;
 }
 
+// Every triangle of m whose box meets the frustum exactly is among `kept` (culling is
+// conservative); returns how many there are.
+size_t checkKeptInsideFrustum(const Mesh& m, const Frustum& f, const std::set<uint32_t>& kept) {
+    size_t inside = 0;
+    for (size_t i = 0; i < m.triangleCount(); ++i) {
+        Bounds3f b;
+        for (int k = 0; k < 3; ++k) b.extend(m.vertex(i, k));
+        if (!boxIntersectsFrustumExact(f, b)) continue;
+        ++inside;
+        CHECK(kept.count(uint32_t(i)) == 1);
+    }
+    return inside;
+}
+
 }  // namespace
 
 TEST_SUITE("exercise 4.1") {
@@ -706,15 +720,7 @@ TEST_SUITE("culling 04") {
             CullCounts counts;
             std::vector<uint32_t> visible = cullHierarchy(bvh, f, test, &counts);
             std::set<uint32_t> kept(visible.begin(), visible.end());
-            size_t inside = 0;
-            for (size_t i = 0; i < m.triangleCount(); ++i) {
-                Bounds3f b;
-                for (int k = 0; k < 3; ++k) b.extend(m.vertex(i, k));
-                if (!boxIntersectsFrustumExact(f, b)) continue;
-                ++inside;
-                CHECK(kept.count(uint32_t(i)) == 1);
-            }
-            CHECK(inside > 100);
+            CHECK(checkKeptInsideFrustum(m, f, kept) > 100);
             CHECK(counts.culled > 0);
             CHECK(counts.visited == counts.culled + counts.kept);
             CHECK(kept.size() < m.triangleCount());
@@ -1613,15 +1619,7 @@ TEST_SUITE("spatial splits 04") {
             CHECK(kept.size() == visible.size());
             CHECK(counts.keptTriangles == visible.size());
             CHECK(kept.size() < m.triangleCount());
-            size_t inside = 0;
-            for (size_t i = 0; i < m.triangleCount(); ++i) {
-                Bounds3f b;
-                for (int k = 0; k < 3; ++k) b.extend(m.vertex(i, k));
-                if (!boxIntersectsFrustumExact(f, b)) continue;
-                ++inside;
-                CHECK(kept.count(uint32_t(i)) == 1);
-            }
-            CHECK(inside > 100);
+            CHECK(checkKeptInsideFrustum(m, f, kept) > 100);
         }
     }
     TEST_CASE("sbvh: bounds without triangles build the binned SAH tree") {

@@ -24,6 +24,7 @@ or refused (bubblewrap cannot create namespaces here and no --no-isolation).
 Environment: BOXES_BWRAP names the bubblewrap program (default: bwrap on PATH).
 """
 import argparse
+import functools
 import itertools
 import os
 import resource
@@ -133,6 +134,7 @@ def _user_tasks(uid):
     return count
 
 
+@functools.cache  # the mounts do not change while the grader runs
 def _pids_hierarchies():
     """Where a new pids cgroup can go: the cgroup v2 root when its pids controller is
     enabled for children, then cgroup v1's pids hierarchy."""
@@ -146,7 +148,7 @@ def _pids_hierarchies():
                 elif len(parts) >= 4 and parts[2] == "cgroup" and "pids" in parts[3].split(","):
                     v1.append(parts[1])
     except OSError:
-        return []
+        return ()
     usable = []
     for mount in v2:
         try:
@@ -155,7 +157,7 @@ def _pids_hierarchies():
                     usable.append(mount)
         except OSError:
             pass
-    return usable + v1
+    return tuple(usable + v1)
 
 
 _cgroup_serial = itertools.count(1)  # next() is atomic: the grader runs jobs on threads

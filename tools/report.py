@@ -67,6 +67,12 @@ def plot(report, spec, out, name):
             continue
         key = str(r[si]) if si is not None else ""
         groups.setdefault(key, []).append((x, y, str(r[li]) if li is not None else ""))
+    # Room around the points, so a label beside the highest or rightmost one is not cut off.
+    ax.margins(x=0.08, y=0.1)
+    # Long names (a whole sentence per variant) only in the legend, not beside their
+    # points, where they ran over each other and out of the figure.
+    names = [key for key in groups if key]
+    short = len(names) <= 6 and all(len(key) <= 24 for key in names)
     for key, pts in groups.items():
         pts.sort()
         style = "o-" if spec.get("lines") else "o"
@@ -75,21 +81,35 @@ def plot(report, spec, out, name):
             for p in pts:
                 ax.annotate(p[2], p[:2], textcoords="offset points", xytext=(4, 3), fontsize=7,
                             color="#555")
-        elif not spec.get("lines") and len(pts) == 1:
+        elif not spec.get("lines") and len(pts) == 1 and short:
             ax.annotate(key, pts[0][:2], textcoords="offset points", xytext=(5, 5), fontsize=8)
-    if spec.get("logx"):
-        ax.set_xscale("symlog" if any(p[0] <= 0 for g in groups.values() for p in g) else "log")
-    if spec.get("logy"):
-        ax.set_yscale("symlog" if any(p[1] <= 0 for g in groups.values() for p in g) else "log")
+
+    def scale(axis, values, log):
+        if not log:
+            return
+        set_scale = ax.set_xscale if axis == "x" else ax.set_yscale
+        if all(v > 0 for v in values):
+            set_scale("log")
+            return
+        # Zeros on a log axis: symlog, linear only below the smallest non-zero magnitude,
+        # so the decades of the data keep their ticks (the default threshold, 1, made the
+        # whole axis of errors below 1 linear, with a tick at each end only).
+        magnitudes = [abs(v) for v in values if v != 0]
+        set_scale("symlog", linthresh=min(magnitudes) if magnitudes else 1.0, linscale=0.5)
+
+    points = [p for g in groups.values() for p in g]
+    scale("x", [p[0] for p in points], spec.get("logx"))
+    scale("y", [p[1] for p in points], spec.get("logy"))
     ax.set_xlabel(spec["x"])
     ax.set_ylabel(spec["y"])
-    ax.set_title(spec.get("title", table["title"]), fontsize=10)
+    ax.set_title(spec.get("title", table["title"]), fontsize=10, wrap=True)
     ax.grid(True, alpha=0.3)
-    if si is not None and len(groups) > 1:
-        ax.legend(fontsize=8)
+    if si is not None and len(groups) > 1:  # below the axes, where it hides no point
+        ax.legend(fontsize=8, loc="upper left", bbox_to_anchor=(0.0, -0.16), frameon=False,
+                  ncol=2 if short else 1)
     fig.tight_layout()
     path = os.path.join(out, name)
-    fig.savefig(path)
+    fig.savefig(path, bbox_inches="tight")  # with a legend below the axes
     plt.close(fig)
     return os.path.basename(path)
 

@@ -132,7 +132,7 @@ int main(int argc, char** argv) {
                     {{"table", "box_accuracy"},
                      {"x", "ns/test"},
                      {"y", "wrong hit/miss"},
-                     {"series", "method"},
+                     {"series", "variant"},
                      {"logy", true},
                      {"title",
                       "Six planes against slabs: time per test and wrong hit/miss answers"}});
@@ -140,7 +140,7 @@ int main(int argc, char** argv) {
                     {{"table", "box_accuracy"},
                      {"x", "ns/test"},
                      {"y", "max rel t error"},
-                     {"series", "method"},
+                     {"series", "variant"},
                      {"logy", true},
                      {"title", "Six planes against slabs: time per test and the error of t"}});
             }

@@ -31,13 +31,67 @@ struct Collapser {
         return ranges[index] = r;
     }
 
-    // A binary node that becomes one leaf: a leaf, or a subtree of at most two packets'
-    // triangles. The four-triangle test costs about one triangle test, so the binned SAH's
-    // usual leaves of 2 (equal costs) left packets half full and nodes half useful; merged
-    // up to 8, motorbike diffuse rays ran about 1.2x faster than up to 4, the bunny alike.
-    bool becomesLeaf(uint32_t index) const {
-        return binary.nodes[index].isLeaf() ||
-               (ranges[index].count != 0 && ranges[index].count <= kBvh4MergedLeafSize);
+    // Which binary subtrees become the wide tree's nodes and leaves: the choice of least
+    // SAH cost (Ylitie, Karras, Laine 2017, "Efficient incoherent ray traversal on GPUs
+    // through compressed wide BVHs", section 4.1), by dynamic programming over the binary
+    // tree. cost[n * W + i - 1] is the least cost of subtree n when it may take up to i
+    // slots of its parent's node: one slot holds n as a leaf or as a wide node; more slots
+    // open n and share them between its two subtrees (leftSlots, 0 when fewer slots are
+    // as cheap). A wide node costs its area times kCollapseNodeCost, a leaf its area times
+    // its packets (four triangles each).
+    std::vector<double> cost;
+    std::vector<uint8_t> leftSlots;
+    std::vector<uint8_t> asLeaf;  // n in one slot: a leaf (else a wide node)
+
+    // A leaf may be a binary leaf or a subtree of at most kBvh4MergedLeafSize primitives.
+    bool mayBeLeaf(uint32_t n) const {
+        return binary.nodes[n].isLeaf() ||
+               (ranges[n].count != 0 && ranges[n].count <= kBvh4MergedLeafSize);
+    }
+    // The least cost of the inner node n opened into up to `slots` slots (at least 2).
+    double opened(uint32_t n, int slots, int& left) const {
+        uint32_t l = binary.nodes[n].leftFirst, r = l + 1;
+        double best = kInfinity<double>;
+        for (int k = 1; k < slots; ++k) {
+            double c = cost[l * W + k - 1] + cost[r * W + slots - k - 1];
+            if (c < best) best = c, left = k;
+        }
+        return best;
+    }
+    void computeCosts(uint32_t n) {
+        const BvhNode& node = binary.nodes[n];
+        // (In double: in float the area of a box 1e20 across is infinite.)
+        double area = Bounds3d(Vec3d(node.boundsMin), Vec3d(node.boundsMax)).surfaceArea();
+        double asLeafCost =
+            mayBeLeaf(n) ? area * double((ranges[n].count + 3) / 4) : kInfinity<double>;
+        double* c = &cost[size_t(n) * W];
+        if (node.isLeaf()) {
+            asLeaf[n] = 1;
+            std::fill(c, c + W, asLeafCost);
+            return;
+        }
+        computeCosts(node.leftFirst);
+        computeCosts(node.leftFirst + 1);
+        int left = 0;
+        double asNodeCost = area * kCollapseNodeCost + opened(n, W, left);
+        asLeaf[n] = asLeafCost <= asNodeCost;
+        c[0] = std::min(asLeafCost, asNodeCost);
+        for (int i = 2; i <= W; ++i) {
+            double split = opened(n, i, left);
+            c[i - 1] = std::min(split, c[i - 2]);
+            if (split < c[i - 2]) leftSlots[size_t(n) * W + i - 1] = uint8_t(left);
+        }
+    }
+    // Appends the subtrees that fill subtree n's (up to) `slots` slots.
+    void collectSlots(uint32_t n, int slots, uint32_t kids[W], int& count) const {
+        while (slots > 1 && leftSlots[size_t(n) * W + slots - 1] == 0) --slots;
+        if (slots == 1) {
+            kids[count++] = n;
+            return;
+        }
+        int left = leftSlots[size_t(n) * W + slots - 1];
+        collectSlots(binary.nodes[n].leftFirst, left, kids, count);
+        collectSlots(binary.nodes[n].leftFirst + 1, slots - left, kids, count);
     }
 
     // Copies a leaf's slots to the next whole packets; returns its first slot.
@@ -64,40 +118,19 @@ struct Collapser {
     // Emits the wide node for the binary inner node `inner` (and, depth first, its
     // subtree); returns its index.
     uint32_t emit(uint32_t inner) {
-        const BvhNode* b = binary.nodes.data();
-        uint32_t kids[W] = {b[inner].leftFirst, b[inner].leftFirst + 1};
-        int n = 2;
-        while (n < W) {
-            // Open the inner child with the largest surface area (-1: flat and point boxes
-            // have area 0 and are still opened).
-            // (In double: in float the area of a box 1e20 across is infinite.)
-            // Failing that, a merged subtree is opened rather than a slot left empty: the
-            // node test costs the same, and smaller leaves test fewer triangles.
-            int open = -1;
-            double openArea = -1.0;
-            for (int pass = 0; pass < 2 && open < 0; ++pass)
-                for (int i = 0; i < n; ++i) {
-                    if (b[kids[i]].isLeaf() || (pass == 0 && becomesLeaf(kids[i]))) continue;
-                    Bounds3d box(Vec3d(b[kids[i]].boundsMin), Vec3d(b[kids[i]].boundsMax));
-                    double area = box.surfaceArea();
-                    if (area > openArea) {
-                        open = i;
-                        openArea = area;
-                    }
-                }
-            if (open < 0) break;
-            uint32_t opened = kids[open];
-            kids[open] = b[opened].leftFirst;
-            kids[n++] = b[opened].leftFirst + 1;
-        }
+        uint32_t kids[W];
+        int n = 0, left = 0;
+        opened(inner, W, left);
+        collectSlots(binary.nodes[inner].leftFirst, left, kids, n);
+        collectSlots(binary.nodes[inner].leftFirst + 1, W - left, kids, n);
         uint32_t index = uint32_t(wide.nodes.size());
         wide.nodes.push_back(emptyNode());
         for (int i = 0; i < n; ++i) {
-            const BvhNode& c = b[kids[i]];
-            bool leaf = becomesLeaf(kids[i]);
+            bool leaf = asLeaf[kids[i]];
             uint32_t child = leaf ? emitLeaf(ranges[kids[i]]) : emit(kids[i]);
             BvhWideNode<W>& node = wide.nodes[index];  // after emit: the vector may have moved
-            setChild(node, i, c.bounds(), child, leaf ? ranges[kids[i]].count : 0);
+            setChild(node, i, binary.nodes[kids[i]].bounds(), child,
+                     leaf ? ranges[kids[i]].count : 0);
         }
         return index;
     }
@@ -126,9 +159,14 @@ BvhWide<W> collapseToWide(const Bvh& binary) {
     if (binary.empty()) return wide;
     wide.root.boundsMin = binary.nodes[0].boundsMin;
     wide.root.boundsMax = binary.nodes[0].boundsMax;
-    Collapser<W> collapser{binary, wide,
-                           std::vector<typename Collapser<W>::SlotRange>(binary.nodes.size())};
+    Collapser<W> collapser{
+        binary, wide, std::vector<typename Collapser<W>::SlotRange>(binary.nodes.size()),
+        {},     {},   {}};
     collapser.computeRanges(0);
+    collapser.cost.resize(binary.nodes.size() * W);
+    collapser.leftSlots.assign(binary.nodes.size() * W, 0);
+    collapser.asLeaf.assign(binary.nodes.size(), 0);
+    collapser.computeCosts(0);
     // Reserved for leaves padded to whole packets (more only makes a vector grow), on huge
     // pages. What is never touched costs no memory, so there is no shrink_to_fit at the
     // end: it copied every array once more, into pages faulted in one by one (with it the
@@ -139,7 +177,7 @@ BvhWide<W> collapseToWide(const Bvh& binary) {
     reserveOnHugePages(wide.leafTriangles, triangles ? slots + slots / 2 : 0);
     reserveOnHugePages(wide.packets, triangles ? slots / 2 + 1 : 0);
     const BvhNode& root = binary.nodes[0];
-    if (collapser.becomesLeaf(0)) {
+    if (collapser.asLeaf[0]) {
         wide.nodes.push_back(Collapser<W>::emptyNode());
         uint32_t first = collapser.emitLeaf(collapser.ranges[0]);
         Collapser<W>::setChild(wide.nodes[0], 0, root.bounds(), first, collapser.ranges[0].count);

@@ -7,6 +7,7 @@
 #include <atomic>
 #include <cfenv>
 #include <chrono>
+#include <cmath>
 #include <cstdlib>
 #include <cstring>
 #include <random>
@@ -1050,7 +1051,8 @@ TEST_SUITE("bvh 4-wide") {
     struct ExhaustiveCollapse {
         const Bvh& binary;
         int width;
-        std::vector<uint32_t> counts;  // primitives per subtree
+        std::vector<uint32_t> counts;      // primitives per subtree
+        mutable std::vector<double> memo;  // best1 per node, once computed (else NaN)
 
         uint32_t count(uint32_t n) {
             const BvhNode& node = binary.nodes[n];
@@ -1086,11 +1088,12 @@ TEST_SUITE("bvh 4-wide") {
             return area(n) * kCollapseNodeCost + best;
         }
         double best1(uint32_t n) const {
+            if (!std::isnan(memo[n])) return memo[n];
             const BvhNode& node = binary.nodes[n];
             double leaf = node.isLeaf() || counts[n] <= kBvh4MergedLeafSize
                               ? area(n) * double((counts[n] + 3) / 4)
                               : kInfinity<double>;
-            return node.isLeaf() ? leaf : std::min(leaf, asNode(n));
+            return memo[n] = node.isLeaf() ? leaf : std::min(leaf, asNode(n));
         }
     };
     TEST_CASE("4- and 8-wide: the collapse takes the children of least SAH cost") {
@@ -1104,8 +1107,9 @@ TEST_SUITE("bvh 4-wide") {
             for (int width : {4, 8}) {
                 CAPTURE(seed);
                 CAPTURE(width);
-                ExhaustiveCollapse exhaustive{binary, width,
-                                              std::vector<uint32_t>(binary.nodes.size())};
+                ExhaustiveCollapse exhaustive{
+                    binary, width, std::vector<uint32_t>(binary.nodes.size()),
+                    std::vector<double>(binary.nodes.size(), std::nan(""))};
                 exhaustive.count(0);
                 double optimum = exhaustive.asNode(0);
                 double built = width == 4 ? collapseCost(collapseToBvh4(binary))

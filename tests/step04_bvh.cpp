@@ -1118,6 +1118,44 @@ TEST_SUITE("bvh 4-wide") {
             }
         }
     }
+    TEST_CASE("4- and 8-wide: the collapse keeps every slot when its costs are NaN") {
+        // A hand-made binary tree: a root over a leaf and an inner node of two leaves, one
+        // leaf box with no extent in x and an infinite one in y. Its area is 0 * infinity
+        // (NaN), and so is every cost that adds it in. The collapse must still keep every
+        // slot, and merge no subtree of more than kBvh4MergedLeafSize primitives into a
+        // leaf (it once merged the inner node's 13: no split compared below infinity).
+        test::FpTrapsOff nanOnPurpose;
+        auto node = [](Vec3 lo, Vec3 hi, uint32_t leftFirst, uint32_t count) {
+            BvhNode n;
+            n.boundsMin = lo;
+            n.boundsMax = hi;
+            n.leftFirst = leftFirst;
+            n.count = count;
+            return n;
+        };
+        const float inf = kInfinity<float>;
+        Bvh binary;
+        binary.nodes.push_back(node({0, -inf, 0}, {2, inf, 1}, 1, 0));  // root
+        binary.nodes.push_back(node({0, 0, 0}, {1, 1, 1}, 0, 1));       // leaf: slot 0
+        binary.nodes.push_back(node({0, -inf, 0}, {2, inf, 1}, 3, 0));  // inner
+        binary.nodes.push_back(node({0, -inf, 0}, {0, inf, 1}, 1, 1));  // leaf: slot 1, NaN area
+        binary.nodes.push_back(node({2, 0, 0}, {2, 1, 1}, 2, 12));      // leaf: slots 2-13
+        binary.primitiveIndices.resize(14);
+        for (uint32_t i = 0; i < 14; ++i) binary.primitiveIndices[i] = i;
+        Bvh4 wide4 = collapseToBvh4(binary);
+        Bvh8 wide8 = collapseToBvh8(binary);
+        checkStructure4(wide4, 14);
+        checkStructure4(wide8, 14);
+        // Leaves: the binary ones (1 and 12 slots) or merged subtrees of at most 8.
+        auto largestLeaf = [](const auto& wide) {
+            uint32_t largest = 0;
+            for (const auto& n : wide.nodes)
+                for (uint32_t count : n.count) largest = std::max(largest, count);
+            return largest;
+        };
+        CHECK(largestLeaf(wide4) == 12);
+        CHECK(largestLeaf(wide8) == 12);
+    }
     template <int W>
     void boxTestCase() {
         // Random boxes and rays, with zero direction components and origins on box planes

@@ -48,12 +48,15 @@ struct Collapser {
         return binary.nodes[n].isLeaf() ||
                (ranges[n].count != 0 && ranges[n].count <= kBvh4MergedLeafSize);
     }
-    // The least cost of the inner node n opened into up to `slots` slots (at least 2).
+    // The least cost of the inner node n opened into up to `slots` slots (at least 2), with
+    // `left` of them for its left subtree (at least 1, whatever the costs, NaN included).
     double opened(uint32_t n, int slots, int& left) const {
-        uint32_t l = binary.nodes[n].leftFirst, r = l + 1;
-        double best = kInfinity<double>;
-        for (int k = 1; k < slots; ++k) {
-            double c = cost[l * W + k - 1] + cost[r * W + slots - k - 1];
+        const double* l = &cost[size_t(binary.nodes[n].leftFirst) * W];
+        const double* r = l + W;  // the right child follows the left one
+        double best = l[0] + r[slots - 2];
+        left = 1;
+        for (int k = 2; k < slots; ++k) {
+            double c = l[k - 1] + r[slots - k - 1];
             if (c < best) best = c, left = k;
         }
         return best;

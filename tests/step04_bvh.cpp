@@ -1023,22 +1023,23 @@ TEST_SUITE("bvh 4-wide") {
     // The collapse's SAH (bvh4.hpp) of a wide tree, read from the tree itself: every wide
     // node's box (its slot in the parent, the root's box for the root) times
     // kCollapseNodeCost, every leaf's box times its packets.
+    // In double, as the collapse computes it.
+    double areaInDouble(const Bounds3f& b) {
+        return Bounds3d(Vec3d(b.min), Vec3d(b.max)).surfaceArea();
+    }
     template <int W>
     double collapseCost(const BvhWide<W>& wide) {
-        auto area = [](const Bounds3f& b) {
-            return Bounds3d(Vec3d(b.min), Vec3d(b.max)).surfaceArea();
-        };
         double total = 0.0;
         std::vector<std::pair<uint32_t, Bounds3f>> stack = {{0, wide.bounds()}};
         while (!stack.empty()) {
             auto [index, box] = stack.back();
             stack.pop_back();
-            total += area(box) * kCollapseNodeCost;
+            total += areaInDouble(box) * kCollapseNodeCost;
             const BvhWideNode<W>& node = wide.nodes[index];
             for (int i = 0; i < W; ++i) {
                 if (node.isEmpty(i)) continue;
                 if (node.isLeaf(i))
-                    total += area(node.bounds(i)) * double((node.count[i] + 3) / 4);
+                    total += areaInDouble(node.bounds(i)) * double((node.count[i] + 3) / 4);
                 else
                     stack.push_back({node.child[i], node.bounds(i)});
             }
@@ -1059,10 +1060,7 @@ TEST_SUITE("bvh 4-wide") {
             return counts[n] = node.isLeaf() ? node.count
                                              : count(node.leftFirst) + count(node.leftFirst + 1);
         }
-        double area(uint32_t n) const {
-            const BvhNode& b = binary.nodes[n];
-            return Bounds3d(Vec3d(b.boundsMin), Vec3d(b.boundsMax)).surfaceArea();
-        }
+        double area(uint32_t n) const { return areaInDouble(binary.nodes[n].bounds()); }
         // Every cut of subtree n into at most `limit` subtrees.
         std::vector<std::vector<uint32_t>> cuts(uint32_t n, int limit) const {
             std::vector<std::vector<uint32_t>> all = {{n}};
@@ -1126,12 +1124,7 @@ TEST_SUITE("bvh 4-wide") {
         // leaf (it once merged the inner node's 13: no split compared below infinity).
         test::FpTrapsOff nanOnPurpose;
         auto node = [](Vec3 lo, Vec3 hi, uint32_t leftFirst, uint32_t count) {
-            BvhNode n;
-            n.boundsMin = lo;
-            n.boundsMax = hi;
-            n.leftFirst = leftFirst;
-            n.count = count;
-            return n;
+            return BvhNode{lo, leftFirst, hi, count};
         };
         const float inf = kInfinity<float>;
         Bvh binary;

@@ -460,6 +460,10 @@ inline uint32_t intersectLeafPackets(Axes axes, const WatertightRay& r, const Wa
         // Lanes that go on to t: all signs equal, decided here (det != 0 follows).
         const __m128 onward =
             _mm_andnot_ps(_mm_or_ps(scalar, mixedSigns), _mm_cmpneq_ps(det, zero));
+        const uint32_t lanes = std::min(4u, first + count - base);
+        const int live = (1 << lanes) - 1;  // the lanes after a leaf's end repeat its last
+        // Most packets a ray meets are missed on every lane: no t to compute, no division.
+        if (((_mm_movemask_ps(onward) | _mm_movemask_ps(scalar)) & live) == 0) continue;
         // Zero the others' edge functions and give them det 1: their t is then 0 / 1, no
         // spurious overflow or 0 / 0 where the scalar test would not have computed t.
         u = _mm_and_ps(u, onward);
@@ -481,8 +485,6 @@ inline uint32_t intersectLeafPackets(Axes axes, const WatertightRay& r, const Wa
             _mm_and_si128(_mm_castps_si128(t), absMask), _mm_set1_epi32(0x7F800000)));
         __m128 hit = _mm_and_ps(_mm_andnot_ps(outOfRange, onward), tFinite);
         hit = _mm_and_ps(hit, _mm_and_ps(_mm_cmpge_ps(t, r4.tmin), _mm_cmple_ps(t, tmax)));
-        const uint32_t lanes = std::min(4u, first + count - base);
-        const int live = (1 << lanes) - 1;  // the lanes after a leaf's end repeat its last
         int hitMask = _mm_movemask_ps(hit) & live;
         if (hitMask != 0) {
             __m128 tHit =

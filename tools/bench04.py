@@ -3,15 +3,15 @@
 
 usage: tools/bench04.py [--rays N] [--repeat K] [--rounds R] [--meshes bunny,motorbike,oa_thor]
                         [--kinds primary,diffuse,random]
-                        [--builders midpoint,median,sah,sah4,sah8,sbvh,sbvh8]
+                        [--builders midpoint,median,sah,sah4,sah8,sbvh,sbvh4,sbvh8]
                         [--no-extras] [--thread-rays N] [--thread-pairs P] [--quiet-wait S]
                         [--out out/04_bvh_bench.json] [--data DIR] [--program PATH]
 
 For every mesh and ray kind (primary, diffuse, random) it writes one ray set with
 peer-bench's make_rays.py, runs peer-bench (Embree 3, one thread) and then our
 `04_bvh trace` with each builder on that file (and "sah 4-wide", "sah 8-wide": the
-binned SAH tree collapsed to 4- or 8-wide nodes, `--width 4` or `--width 8`; "sbvh" and
-"sbvh 8-wide": the binned SAH with spatial splits, not an exercise), each run
+binned SAH tree collapsed to 4- or 8-wide nodes, `--width 4` or `--width 8`; "sbvh",
+"sbvh 4-wide" and "sbvh 8-wide": the binned SAH with spatial splits, not an exercise), each run
 --repeat passes (the programs report the median), all of it --rounds times, alternating;
 the ratios are the medians of the rounds' own ratios. Each round first waits (at most
 --quiet-wait s) until a short probe runs at 90% of its best speed: some minutes on a shared
@@ -183,7 +183,7 @@ def main():
                     help="runs of Embree and every builder, alternating (medians of the ratios)")
     ap.add_argument("--meshes", default="bunny,motorbike,oa_thor")
     ap.add_argument("--kinds", default="primary,diffuse,random")
-    ap.add_argument("--builders", default="midpoint,median,sah,sah4,sah8,sbvh,sbvh8",
+    ap.add_argument("--builders", default="midpoint,median,sah,sah4,sah8,sbvh,sbvh4,sbvh8",
                     help="sah4, sah8: the binned SAH tree collapsed to 4- or 8-wide nodes (SIMD)")
     ap.add_argument("--no-extras", action="store_true",
                     help="skip the two-thread runs and the sweep-SAH quality reference")
@@ -226,6 +226,7 @@ def main():
                 ("sah 4-wide", "sah4", ["--builder", "sah", "--width", "4"]),
                 ("sah 8-wide", "sah8", ["--builder", "sah", "--width", "8"]),
                 ("sbvh", "sbvh", ["--builder", "sbvh"]),
+                ("sbvh 4-wide", "sbvh4", ["--builder", "sbvh", "--width", "4"]),
                 ("sbvh 8-wide", "sbvh8", ["--builder", "sbvh", "--width", "8"]))
                 if key in a.builders.split(",")]
             ehits, ohits = os.path.join(work, "embree.bin"), os.path.join(work, "ours.bin")
@@ -310,7 +311,8 @@ def main():
             print("  %-10s %.2fx  %.2fx" % (mesh, paired(by[sah], by["midpoint"], "mrays_per_s"),
                                             paired(by[sah], by["midpoint"], "mrays_per_cpu_s")))
     print("\nSpatial splits against the binned SAH (same width; wall, CPU time):")
-    for plain, split in (("sah", "sbvh"), ("sah 8-wide", "sbvh 8-wide")):
+    for plain, split in (("sah", "sbvh"), ("sah 4-wide", "sbvh 4-wide"),
+                         ("sah 8-wide", "sbvh 8-wide")):
         for mesh in a.meshes.split(","):
             for kind in a.kinds.split(","):
                 by = {r["builder"]: r for r in rows if r["mesh"] == mesh and r["kind"] == kind}

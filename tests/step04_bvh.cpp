@@ -1020,13 +1020,13 @@ TEST_SUITE("bvh 4-wide") {
         CHECK(wide8.bounds() == binary.bounds());
         CHECK(reinterpret_cast<uintptr_t>(wide8.nodes.data()) % 64 == 0);
     }
-    // The collapse's SAH (bvh4.hpp) of a wide tree, read from the tree itself: every wide
-    // node's box (its slot in the parent, the root's box for the root) times
-    // kCollapseNodeCost, every leaf's box times its packets.
-    // In double, as the collapse computes it.
+    // A box's area in double, as the collapse computes it.
     double areaInDouble(const Bounds3f& b) {
         return Bounds3d(Vec3d(b.min), Vec3d(b.max)).surfaceArea();
     }
+    // The collapse's SAH (bvh4.hpp) of a wide tree, read from the tree itself: every wide
+    // node's box (its slot in the parent, the root's box for the root) times
+    // kCollapseNodeCost, every leaf's box times its packets.
     template <int W>
     double collapseCost(const BvhWide<W>& wide) {
         double total = 0.0;

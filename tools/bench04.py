@@ -184,7 +184,7 @@ def main():
     ap.add_argument("--meshes", default="bunny,motorbike,oa_thor")
     ap.add_argument("--kinds", default="primary,diffuse,random")
     ap.add_argument("--builders", default="midpoint,median,sah,sah4,sah8,sbvh,sbvh4,sbvh8",
-                    help="sah4, sah8: the binned SAH tree collapsed to 4- or 8-wide nodes (SIMD)")
+                    help="sah4, sah8, sbvh4, sbvh8: the tree collapsed to 4- or 8-wide nodes (SIMD)")
     ap.add_argument("--no-extras", action="store_true",
                     help="skip the two-thread runs and the sweep-SAH quality reference")
     ap.add_argument("--thread-rays", type=int, default=500000,

@@ -463,7 +463,7 @@ inline uint32_t intersectLeafPackets(Axes axes, const WatertightRay& r, const Wa
         const uint32_t lanes = std::min(4u, first + count - base);
         const int live = (1 << lanes) - 1;  // the lanes after a leaf's end repeat its last
         // Most packets a ray meets are missed on every lane: no t to compute, no division.
-        if (((_mm_movemask_ps(onward) | _mm_movemask_ps(scalar)) & live) == 0) continue;
+        if ((_mm_movemask_ps(_mm_or_ps(onward, scalar)) & live) == 0) continue;
         // Zero the others' edge functions and give them det 1: their t is then 0 / 1, no
         // spurious overflow or 0 / 0 where the scalar test would not have computed t.
         u = _mm_and_ps(u, onward);

@@ -1367,6 +1367,61 @@ TEST_SUITE("bvh 4-wide") {
     TEST_CASE("8-wide: nearest and any hit equal brute force on real meshes") {
         realMeshCase<8>();
     }
+    TEST_CASE("trace --count: the work of one ray counted by hand") {
+        // Two clusters of three stacked triangles, at x = 0 and x = 100 (z = 0, -1, -2).
+        // The midpoint builder (leaves of up to 4) puts each in a leaf under the root. The
+        // 4-wide collapse takes the whole tree as one leaf of 6 (two packets): its cost,
+        // the root's area times 2 packets, is below a node's (the same plus the leaves').
+        Mesh m;
+        for (float x : {0.0f, 100.0f})
+            for (float z : {0.0f, -1.0f, -2.0f}) {
+                auto first = uint32_t(m.positions.size());
+                m.positions.insert(m.positions.end(), {{x, 0, z}, {x + 1, 0, z}, {x, 1, z}});
+                m.triangles.push_back({first, first + 1, first + 2});
+            }
+        BvhBuildOptions options = optionsFor(BvhBuilder::Midpoint);
+        options.leafSize = 4;
+        Bvh binary = buildBvh(m, options);
+        REQUIRE(binary.nodes.size() == 3);
+        Bvh4 wide = collapseToBvh4(binary);
+        REQUIRE(bvh4Stats(wide).nodes == 1);
+        REQUIRE(bvh4Stats(wide).leaves == 1);
+        // Down through the first cluster: the binary tree tests its leaf's 3 triangles (the
+        // other leaf's box is missed), the 4-wide tree one node and the merged leaf's 6.
+        std::vector<Ray> down = {Ray(Vec3(0.25f, 0.25f, 5.0f), Vec3(0, 0, -1))};
+        TraversalCounts b = countWork(binary, down), w = countWork(wide, down);
+        CHECK(b.rays == 1);
+        CHECK(b.triangles == 3);
+        CHECK(w.nodes == 1);
+        CHECK(w.leaves == 1);
+        CHECK(w.packets == 2);
+        CHECK(w.triangles == 6);
+        // Beside the root box (y = 50): nothing at all.
+        std::vector<Ray> beside = {Ray(Vec3(50.0f, 50.0f, 5.0f), Vec3(0, 0, -1))};
+        TraversalCounts bm = countWork(binary, beside), wm = countWork(wide, beside);
+        CHECK(bm.triangles == 0);
+        CHECK(wm.nodes + wm.leaves + wm.packets + wm.triangles == 0);
+    }
+    TEST_CASE("trace --count: counting changes no hit, and the counts fit together") {
+        Mesh m = triangleSoup(1500, 40);
+        Bvh binary = buildBvh(m, optionsFor(BvhBuilder::BinnedSah));
+        Bvh8 wide = collapseToBvh8(binary);
+        std::vector<Ray> rays = randomRays(500, 41);
+        for (const Ray& ray : rays) {
+            TraversalCounts c;
+            CHECK(traceNearest(wide, ray, TraversalCounter{&c}) == traceNearest(wide, ray));
+            CHECK(traceNearest(binary, ray, TraversalCounter{&c}) == traceNearest(binary, ray));
+        }
+        TraversalCounts w = countWork(wide, rays);
+        CHECK(w.rays == 500);
+        CHECK(w.nodes > 500);  // most random rays cross the soup
+        // A leaf is 1 to 4 packets (a binary leaf of up to maxLeafSize = 16 stays a leaf),
+        // a packet 1 to 4 triangles.
+        CHECK(w.leaves <= w.packets);
+        CHECK(w.packets <= 4 * w.leaves);
+        CHECK(w.packets <= w.triangles);
+        CHECK(w.triangles <= 4 * w.packets);
+    }
     template <int W>
     void cracksCase() {
         for (const char* name : {"sh1", "bunny"}) {

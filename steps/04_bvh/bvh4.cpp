@@ -228,5 +228,11 @@ void traceBatch(const Bvh8& bvh, const std::vector<Ray>& rays, std::vector<Trace
                 int threads) {
     traceBatchOf(bvh, rays, hits, threads);
 }
+TraversalCounts countWork(const Bvh4& bvh, const std::vector<Ray>& rays) {
+    return countWorkOf(bvh, rays);
+}
+TraversalCounts countWork(const Bvh8& bvh, const std::vector<Ray>& rays) {
+    return countWorkOf(bvh, rays);
+}
 
 }  // namespace boxes

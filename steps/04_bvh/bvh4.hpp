@@ -264,9 +264,10 @@ constexpr int kBvh4StackSize = kWideStackSize<4>;
 // Nearest hit, nearest child first, early out. intersectLeaf(first, count, tClosest) tests
 // a leaf's slots [first, first + count), lowers tClosest on a hit and returns the slot of
 // its nearest hit (or kTraversalMiss). Returns the slot of the nearest hit or kTraversalMiss.
-template <bool kAvx = false, int W, typename LeafIntersector>
+template <bool kAvx = false, int W, typename LeafIntersector, typename NodeCount = NoTraversalCount>
 uint32_t traverseNearest4Leaves(const BvhWide<W>& bvh, const TraversalRay& traversal,
-                                float& tClosest, LeafIntersector&& intersectLeaf) {
+                                float& tClosest, LeafIntersector&& intersectLeaf,
+                                NodeCount nodeCount = {}) {  // counts (countWork) or not
     if (bvh.empty()) return kTraversalMiss;
     const WideRay<W> ray(traversal);
     const BvhWideNode<W>* nodes = bvh.nodes.data();
@@ -280,6 +281,7 @@ uint32_t traverseNearest4Leaves(const BvhWide<W>& bvh, const TraversalRay& trave
     for (;;) {
         if (count == 0) {
             const BvhWideNode<W>& node = nodes[child];
+            nodeCount.node();
             alignas(32) float t[W];
             int mask = intersectChildBoundsFor<kAvx>(node, ray, tClosest, t);
             if (mask != 0) {
@@ -511,9 +513,10 @@ inline uint32_t intersectLeafPackets(Axes axes, const WatertightRay& r, const Wa
     return nearest;
 }
 
-// kAvx: only from code compiled for AVX2 (the batch tracers' AVX2 loop).
-template <bool kAvx = false, int W>
-inline TraceHit traceNearest(const BvhWide<W>& bvh, const Ray& ray) {
+// kAvx: only from code compiled for AVX2 (the batch tracers' AVX2 loop). With a
+// TraversalCounter, the work is counted (countWork); the hit is the same.
+template <bool kAvx = false, int W, typename Counter = NoTraversalCount>
+inline TraceHit traceNearest(const BvhWide<W>& bvh, const Ray& ray, Counter counter = {}) {
     TraversalRay traversal(ray, traversalMargin(ray, bvh));
     if (!entersRoot(bvh, traversal)) return {};
     WatertightRay watertight(ray);
@@ -521,9 +524,13 @@ inline TraceHit traceNearest(const BvhWide<W>& bvh, const Ray& ray) {
     float tClosest = ray.tmax;
     uint32_t slot = withWatertightAxes(watertight, [&](auto axes) {
         return traverseNearest4Leaves<kAvx>(
-            bvh, traversal, tClosest, [&](uint32_t first, uint32_t count, float& tmax) {
+            bvh, traversal, tClosest,
+            [&](uint32_t first, uint32_t count, float& tmax) {
+                counter.leaf((count + 3) / 4);
+                counter.triangles(count);
                 return intersectLeafPackets(axes, watertight, watertight4, bvh, first, count, tmax);
-            });
+            },
+            counter);
     });
     if (slot == kTraversalMiss) return {};
     return {tClosest, bvh.primitiveIndices[slot]};
@@ -547,5 +554,7 @@ void traceBatch(const Bvh4& bvh, const std::vector<Ray>& rays, std::vector<Trace
                 int threads);
 void traceBatch(const Bvh8& bvh, const std::vector<Ray>& rays, std::vector<TraceHit>& hits,
                 int threads);
+TraversalCounts countWork(const Bvh4& bvh, const std::vector<Ray>& rays);
+TraversalCounts countWork(const Bvh8& bvh, const std::vector<Ray>& rays);
 
 }  // namespace boxes

@@ -32,6 +32,7 @@ double processCpuSeconds() {
 struct TraceOptions {
     std::string mesh, rays, hits, builder = "sah";
     int threads = 1, repeat = 1, bins = 16, width = 2;
+    bool count = false;
 };
 
 // `trace`: build, trace every ray (median of --repeat), write HITS.bin, one JSON line.
@@ -94,6 +95,19 @@ int runTrace(const TraceOptions& o) {
         std::string suffix = "_" + std::to_string(o.width) + "wide";
         j["nodes" + suffix] = wideStats.nodes;
         j["depth" + suffix] = wideStats.depth;
+    }
+    // --count: the work per ray, from one more pass outside the timed ones.
+    if (o.count) {
+        TraversalCounts c = o.width == 4   ? countWork(wide, rays)
+                            : o.width == 8 ? countWork(wide8, rays)
+                                           : countWork(bvh, rays);
+        double perRay = rays.empty() ? 0.0 : 1.0 / double(rays.size());
+        j["triangles_per_ray"] = double(c.triangles) * perRay;
+        if (o.width != 2) {
+            j["nodes_per_ray"] = double(c.nodes) * perRay;
+            j["leaves_per_ray"] = double(c.leaves) * perRay;
+            j["packets_per_ray"] = double(c.packets) * perRay;
+        }
     }
     std::cout << j.dump() << "\n";
     return 0;
@@ -229,6 +243,10 @@ int main(int argc, char** argv) {
         traceCommand->add_option("--bins", trace.bins, "binned SAH: bins per axis")
             ->check(CLI::Range(2, 256))
             ->capture_default_str();
+        traceCommand->add_flag("--count", trace.count,
+                               "also count the work per ray (one more, untimed pass): "
+                               "triangles tested; with --width 4 or 8 also nodes, leaves "
+                               "and packets");
 
         CheckOptions check;
         CLI::App* checkCommand = app.add_subcommand(

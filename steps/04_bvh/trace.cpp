@@ -119,6 +119,10 @@ void traceBatch(const Bvh& bvh, const std::vector<Ray>& rays, std::vector<TraceH
     traceBatchOf(bvh, rays, hits, threads);
 }
 
+TraversalCounts countWork(const Bvh& bvh, const std::vector<Ray>& rays) {
+    return countWorkOf(bvh, rays);
+}
+
 void forEachRayChunk(size_t count, int threads, const std::function<void(size_t, size_t)>& f) {
     constexpr size_t kChunk = 1024;
     std::atomic<size_t> next{0};

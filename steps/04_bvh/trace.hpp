@@ -15,6 +15,31 @@
 
 namespace boxes {
 
+// The work of tracing a batch of rays, summed over the rays (`trace --count`): a count of
+// what the traversal does, the same on every machine, where a time is not. The binary
+// tree's loop is exercise 4.4, so only its triangle tests are counted (from the leaf test
+// it calls); the wide trees' loops count their nodes, leaves and packets too.
+struct TraversalCounts {
+    uint64_t rays = 0;
+    uint64_t nodes = 0;      // wide nodes whose boxes were tested (wide trees only)
+    uint64_t leaves = 0;     // leaves tested (wide trees only)
+    uint64_t packets = 0;    // packets of four triangles tested (wide trees only)
+    uint64_t triangles = 0;  // triangles tested (a packet's padding lanes not counted)
+};
+// The counting policies of the traversal templates: no count (the timed loops), or into
+// a TraversalCounts.
+struct NoTraversalCount {
+    void node() {}
+    void leaf(uint32_t) {}
+    void triangles(uint32_t) {}
+};
+struct TraversalCounter {
+    TraversalCounts* counts;
+    void node() { ++counts->nodes; }
+    void leaf(uint32_t packets) { ++counts->leaves, counts->packets += packets; }
+    void triangles(uint32_t n) { counts->triangles += n; }
+};
+
 // The watertight ray/triangle test of Woop, Benthin and Wald (JCGT 2013), prepared once
 // per ray. This is a performance copy of step 01's exercise 1.5 (which stays the teaching
 // version): the permutation and shear are computed once per ray instead of per triangle,
@@ -175,8 +200,9 @@ template <typename Tree>
 
 // kAvx selects the wide trees' AVX box test (bvh4.hpp); the binary tree has none and
 // ignores it. The parameter lets one batch loop (traceBatchOf below) serve every tree.
-template <bool kAvx = false>
-inline TraceHit traceNearest(const Bvh& bvh, const Ray& ray) {
+// With a TraversalCounter, the triangle tests are counted (countWork); the hit is the same.
+template <bool kAvx = false, typename Counter = NoTraversalCount>
+inline TraceHit traceNearest(const Bvh& bvh, const Ray& ray, Counter counter = {}) {
     TraversalRay traversal(ray, bvh);
     // Most rays of a camera framing a mesh miss its root box: decide that before the
     // triangle test's per-ray set-up (three divisions) and the dispatch on its axes.
@@ -186,6 +212,7 @@ inline TraceHit traceNearest(const Bvh& bvh, const Ray& ray) {
     const LeafTriangle* tris = bvh.leafTriangles.data();
     uint32_t slot = withWatertightAxes(watertight, [&](auto axes) {
         return traverseNearest(bvh, traversal, tClosest, [&](uint32_t s, float& tmax) {
+            counter.triangles(1);
             return intersectLeafTriangle(axes, watertight, tris[s], tmax);
         });
     });
@@ -287,6 +314,16 @@ void traceBatchOf(const Tree& tree, const std::vector<Ray>& rays, std::vector<Tr
         range(tree, rays.data(), hits.data(), begin, end);
     });
 }
+
+// Counts the work of tracing `rays` (one thread, in order: the same counts every run).
+template <typename Tree>
+TraversalCounts countWorkOf(const Tree& tree, const std::vector<Ray>& rays) {
+    TraversalCounts counts;
+    counts.rays = rays.size();
+    for (const Ray& ray : rays) traceNearest(tree, ray, TraversalCounter{&counts});
+    return counts;
+}
+TraversalCounts countWork(const Bvh& bvh, const std::vector<Ray>& rays);
 
 // Does a hierarchy's hit agree with brute force: the same triangle, or the same t (two
 // triangles sharing the hit point)?

@@ -10,6 +10,7 @@
 #include <cmath>
 #include <cstdlib>
 #include <cstring>
+#include <nlohmann/json.hpp>
 #include <random>
 #include <set>
 #include <stdexcept>
@@ -1974,7 +1975,7 @@ TEST_SUITE("program 04") {
             auto run = test::runProgram(program,
                                         "trace --mesh " + test::dataDir() +
                                             "/meshes/sh1.obj --rays rays.bin --hits " + hits +
-                                            " --builder sah --width " + w,
+                                            " --builder sah --width " + w + " --count",
                                         dir);
             INFO(run.err);
             REQUIRE(run.exitCode == 0);
@@ -1984,6 +1985,15 @@ TEST_SUITE("program 04") {
                                       : bvhWideStats(collapseToBvh8(binary)).nodes;
             CHECK(run.out.find("\"nodes_" + w + "wide\":" + std::to_string(nodes)) !=
                   std::string::npos);
+            // --count: the work per ray, as countWork counts it on the same tree and rays.
+            TraversalCounts c = width == 4 ? countWork(collapseToBvh4(binary), rays)
+                                           : countWork(collapseToBvh8(binary), rays);
+            nlohmann::json j = nlohmann::json::parse(run.out);
+            CHECK(j["nodes_per_ray"].get<double>() == doctest::Approx(double(c.nodes) / 600));
+            CHECK(j["packets_per_ray"].get<double>() == doctest::Approx(double(c.packets) / 600));
+            CHECK(j["triangles_per_ray"].get<double>() ==
+                  doctest::Approx(double(c.triangles) / 600));
+            CHECK(c.nodes > 600);
             CHECK(checkHitsFileAgainstBruteForce(dir.file(hits), sh1, rays) > 100);
         }
         auto bad = test::runProgram(program,

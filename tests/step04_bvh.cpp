@@ -1387,6 +1387,17 @@ TEST_SUITE("bvh 4-wide") {
         Bvh4 wide = collapseToBvh4(binary);
         REQUIRE(bvh4Stats(wide).nodes == 1);
         REQUIRE(bvh4Stats(wide).leaves == 1);
+        // Its SAH cost in Embree's units: the root node (area ratio 1) and one leaf with
+        // the root's box and two packets.
+        CHECK(bvh4Stats(wide).nodeSahCost == 1.0);
+        CHECK(bvh4Stats(wide).leafSahCost == 2.0);
+        // A root without area (one triangle on a line) has no ratio: 0, not NaN.
+        Mesh line;
+        line.positions = {{0, 0, 0}, {1, 0, 0}, {2, 0, 0}};
+        line.triangles = {{0, 1, 2}};
+        Bvh4Stats flat = bvh4Stats(collapseToBvh4(buildBvh(line, options)));
+        CHECK(flat.nodeSahCost == 0.0);
+        CHECK(flat.leafSahCost == 0.0);
         // Down through the first cluster: the binary tree tests its leaf's 3 triangles (the
         // other leaf's box is missed), the 4-wide tree one node and the merged leaf's 6.
         std::vector<Ray> down = {Ray(Vec3(0.25f, 0.25f, 5.0f), Vec3(0, 0, -1))};
@@ -1989,6 +2000,11 @@ TEST_SUITE("program 04") {
             TraversalCounts c = width == 4 ? countWork(collapseToBvh4(binary), rays)
                                            : countWork(collapseToBvh8(binary), rays);
             nlohmann::json j = nlohmann::json::parse(run.out);
+            BvhWideStats ws = width == 4 ? bvhWideStats(collapseToBvh4(binary))
+                                         : bvhWideStats(collapseToBvh8(binary));
+            CHECK(ws.nodeSahCost > 1.0);  // the root and more
+            CHECK(j["sah_cost_" + w + "wide"].get<double>() ==
+                  doctest::Approx(ws.nodeSahCost + ws.leafSahCost));
             CHECK(j["nodes_per_ray"].get<double>() == doctest::Approx(double(c.nodes) / 600));
             CHECK(j["packets_per_ray"].get<double>() == doctest::Approx(double(c.packets) / 600));
             CHECK(j["triangles_per_ray"].get<double>() ==

@@ -1,6 +1,7 @@
 #include "04_bvh/bvh4.hpp"
 
 #include <algorithm>
+#include <cmath>
 
 namespace boxes {
 
@@ -198,10 +199,21 @@ BvhWideStats bvhWideStats(const BvhWide<W>& bvh) {
     BvhWideStats s;
     s.nodes = bvh.nodes.size();
     if (bvh.empty()) return s;
-    std::vector<std::pair<uint32_t, int>> stack = {{0, 0}};
+    // Areas in double: in float the area of a box 1e20 across is infinite.
+    auto areaOf = [](const Bounds3f& b) {
+        return Bounds3d(Vec3d(b.min), Vec3d(b.max)).surfaceArea();
+    };
+    double rootArea = areaOf(bvh.bounds());
+    struct Entry {
+        uint32_t index;
+        int depth;
+        double area;
+    };
+    std::vector<Entry> stack = {{0, 0, rootArea}};
     while (!stack.empty()) {
-        auto [index, depth] = stack.back();
+        auto [index, depth, area] = stack.back();
         stack.pop_back();
+        s.nodeSahCost += area;
         const BvhWideNode<W>& node = bvh.nodes[index];
         for (int i = 0; i < W; ++i) {
             if (node.isEmpty(i)) {
@@ -209,11 +221,17 @@ BvhWideStats bvhWideStats(const BvhWide<W>& bvh) {
             } else if (node.isLeaf(i)) {
                 ++s.leaves;
                 s.depth = std::max(s.depth, depth + 1);
+                s.leafSahCost += areaOf(node.bounds(i)) * double((node.count[i] + 3) / 4);
             } else {
-                stack.push_back({node.child[i], depth + 1});
+                stack.push_back({node.child[i], depth + 1, areaOf(node.bounds(i))});
             }
         }
     }
+    // Relative to the root's area; a root without area (a flat or one-point scene) has no
+    // meaningful ratio, and the costs stay 0.
+    bool ratio = rootArea > 0.0 && std::isfinite(rootArea);
+    s.nodeSahCost = ratio ? s.nodeSahCost / rootArea : 0.0;
+    s.leafSahCost = ratio ? s.leafSahCost / rootArea : 0.0;
     return s;
 }
 

@@ -95,6 +95,7 @@ int runTrace(const TraceOptions& o) {
         std::string suffix = "_" + std::to_string(o.width) + "wide";
         j["nodes" + suffix] = wideStats.nodes;
         j["depth" + suffix] = wideStats.depth;
+        j["sah_cost" + suffix] = wideStats.nodeSahCost + wideStats.leafSahCost;
     }
     // --count: the work per ray, from one more pass outside the timed ones.
     if (o.count) {

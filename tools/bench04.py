@@ -26,6 +26,7 @@ Needs: libembree-dev, python3-numpy (tools/deps.sh bench), the release build.
 import argparse
 import json
 import os
+import re
 import resource
 import shutil
 import statistics
@@ -72,6 +73,19 @@ def run_embree(cmd, repeat):
     c2 = children_cpu()
     j["mrays_per_cpu_s"] = j["rays"] / max(1e-9, ((c2 - c1) - (c1 - c0)) / passes) / 1e6
     return j
+
+
+def embree_tree_sah(peer, obj, rays, work):
+    """The SAH cost Embree prints for the tree it traces (verbose=3: each node its area, each
+    leaf its area times its blocks of four, over the root's; the last build is the traced
+    one), from one traced ray. None when its output has no such line."""
+    one = os.path.join(work, "one-ray.bin")
+    with open(rays, "rb") as f, open(one, "wb") as g:
+        g.write(f.read(32))
+    out = subprocess.run([peer, obj, one, os.path.join(work, "one-hit.bin"), "--repeat", "1",
+                          "--config", "verbose=3"], capture_output=True, text=True)
+    costs = re.findall(r"total\s*: sah =\s*([0-9.]+)", out.stdout + out.stderr)
+    return float(costs[-1]) if costs else None
 
 
 def run_ours(cmd, repeat):
@@ -206,7 +220,7 @@ def main():
     subprocess.run(["sh", os.path.join(peer_src, "build.sh")], check=True, capture_output=True)
     peer = os.path.join(peer_src, "peer-bench")
     gate = QuietGate(a, peer_src, work)
-    rows, threads, quality = [], [], []
+    rows, threads, quality, tree_sah = [], [], [], {}
     for mesh in a.meshes.split(","):
         obj = os.path.join(a.data, mesh + ".obj")
         sweep = None
@@ -272,6 +286,11 @@ def main():
                          row["agree_with_embree"]), file=sys.stderr)
             if kind in ("primary", "diffuse") and not a.no_extras:
                 threads.append(measure_threads(a, peer, obj, mesh, kind, work, gate))
+            if mesh not in tree_sah and not a.no_extras:
+                ours = {r["builder"]: r["runs"][0].get("sah_cost_8wide") for r in rows
+                        if r["mesh"] == mesh and r["builder"] in ("sah 8-wide", "sbvh 8-wide")}
+                tree_sah[mesh] = {"embree": embree_tree_sah(peer, obj, rays, work),
+                                  "sah8": ours.get("sah 8-wide"), "sbvh8": ours.get("sbvh 8-wide")}
             if sweep is None and not a.no_extras:
                 sweep = run_json([a.program, "trace", "--mesh", obj, "--rays", rays, "--hits", ohits,
                                   "--builder", "sweep-sah"])
@@ -337,6 +356,12 @@ def main():
               "(+%.2f%%)" % (q["mesh"], q["tris"], q["build_ms"], q["s_per_mtri"],
                             q["cpu_s_per_mtri"], q["sah_cost"], q["sweep_sah_cost"],
                             q["excess_pct"]))
+    print("\nTree quality in the units of Embree's statistics (8-wide: each node its area, "
+          "each leaf its area times its packets or blocks, over the root's; lower is better):")
+    for mesh, t in tree_sah.items():
+        print("  %-10s Embree %s  sah 8-wide %s  sbvh 8-wide %s" % (
+            mesh, *("%.2f" % v if v is not None else "-" for v in
+                    (t["embree"], t["sah8"], t["sbvh8"]))))
     print("\nTwo threads against one (binned SAH; %d rays per set, medians of %d alternating "
           "pairs; Embree's own speed-up on the same rays beside it, its threads started for "
           "every pass by peer-bench):" % (a.thread_rays, a.thread_pairs))
@@ -393,6 +418,16 @@ def main():
                    "rows": [[q["mesh"], q["tris"], q["build_ms"], q["s_per_mtri"],
                              q["cpu_s_per_mtri"], q["sah_cost"], q["sweep_sah_cost"],
                              q["excess_pct"]] for q in quality], "note": ""},
+                  {"id": "bench04_tree_sah",
+                   "title": "Tree quality beside Embree's, in its statistics' units",
+                   "columns": ["mesh", "Embree", "sah 8-wide", "sbvh 8-wide"],
+                   "rows": [[m, t["embree"], t["sah8"], t["sbvh8"]]
+                            for m, t in tree_sah.items()],
+                   "note": "The SAH cost Embree prints for its traced tree (peer-bench --config "
+                           "verbose=3: each 8-wide node its area, each leaf its area times its "
+                           "blocks of four triangles, over the root's area) and ours in the same "
+                           "units (trace --width 8: sah_cost_8wide, packets for blocks); lower "
+                           "is better"},
                   {"id": "bench04_threads", "title": "Two threads against one (binned SAH)",
                    "columns": ["mesh", "rays", "1 thread", "2 threads", "speed-up",
                                "Embree speed-up"],

@@ -1414,7 +1414,7 @@ TEST_SUITE("bvh 4-wide") {
         CHECK(bm.triangles == 0);
         CHECK(wm.nodes + wm.leaves + wm.packets + wm.triangles == 0);
     }
-    TEST_CASE("trace --count: counting changes no hit, and the counts fit together") {
+    TEST_CASE("trace --count: counting changes no hit and the counts fit together") {
         Mesh m = triangleSoup(1500, 40);
         Bvh binary = buildBvh(m, optionsFor(BvhBuilder::BinnedSah));
         Bvh8 wide = collapseToBvh8(binary);

@@ -36,7 +36,10 @@ struct NoTraversalCount {
 struct TraversalCounter {
     TraversalCounts* counts;
     void node() { ++counts->nodes; }
-    void leaf(uint32_t packets) { ++counts->leaves, counts->packets += packets; }
+    void leaf(uint32_t packets) {
+        ++counts->leaves;
+        counts->packets += packets;
+    }
     void triangles(uint32_t n) { counts->triangles += n; }
 };
 

@@ -7,6 +7,11 @@ namespace boxes {
 
 namespace {
 
+// A box's surface area in double: in float the area of a box 1e20 across is infinite.
+double areaInDouble(const Bounds3f& b) {
+    return Bounds3d(Vec3d(b.min), Vec3d(b.max)).surfaceArea();
+}
+
 template <int W>
 struct Collapser {
     const Bvh& binary;
@@ -64,8 +69,7 @@ struct Collapser {
     }
     void computeCosts(uint32_t n) {
         const BvhNode& node = binary.nodes[n];
-        // (In double: in float the area of a box 1e20 across is infinite.)
-        double area = Bounds3d(Vec3d(node.boundsMin), Vec3d(node.boundsMax)).surfaceArea();
+        double area = areaInDouble(node.bounds());
         double asLeafCost =
             mayBeLeaf(n) ? area * double((ranges[n].count + 3) / 4) : kInfinity<double>;
         double* c = &cost[size_t(n) * W];
@@ -199,11 +203,7 @@ BvhWideStats bvhWideStats(const BvhWide<W>& bvh) {
     BvhWideStats s;
     s.nodes = bvh.nodes.size();
     if (bvh.empty()) return s;
-    // Areas in double: in float the area of a box 1e20 across is infinite.
-    auto areaOf = [](const Bounds3f& b) {
-        return Bounds3d(Vec3d(b.min), Vec3d(b.max)).surfaceArea();
-    };
-    double rootArea = areaOf(bvh.bounds());
+    double rootArea = areaInDouble(bvh.bounds());
     struct Entry {
         uint32_t index;
         int depth;
@@ -221,9 +221,9 @@ BvhWideStats bvhWideStats(const BvhWide<W>& bvh) {
             } else if (node.isLeaf(i)) {
                 ++s.leaves;
                 s.depth = std::max(s.depth, depth + 1);
-                s.leafSahCost += areaOf(node.bounds(i)) * double((node.count[i] + 3) / 4);
+                s.leafSahCost += areaInDouble(node.bounds(i)) * double((node.count[i] + 3) / 4);
             } else {
-                stack.push_back({node.child[i], depth + 1, areaOf(node.bounds(i))});
+                stack.push_back({node.child[i], depth + 1, areaInDouble(node.bounds(i))});
             }
         }
     }

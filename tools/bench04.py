@@ -298,7 +298,8 @@ def main():
                 if not sah:
                     continue
                 sah = sah[0]
-                quality.append({"mesh": mesh, "tris": sah["tris"], "sah_cost": sah["sah_cost"],
+                quality.append({"mesh": mesh, "tris": sah["tris"], "bins": sah["bins"],
+                                "sah_cost": sah["sah_cost"],
                                 "sweep_sah_cost": sweep["sah_cost"],
                                 "excess_pct": 100.0 * (sah["sah_cost"] / sweep["sah_cost"] - 1.0),
                                 "build_ms": sah["build_ms"],
@@ -350,7 +351,8 @@ def main():
                 print("  %-10s %-8s %.2fx  %.2fx" % (
                     mesh, kind, paired(by[wide], by["sah"], "mrays_per_s"),
                     paired(by[wide], by["sah"], "mrays_per_cpu_s")))
-    print("\nBuild and quality (binned SAH, 16 bins, one thread):")
+    bins = sorted({q["bins"] for q in quality})
+    print("\nBuild and quality (binned SAH, %s bins, one thread):" % "/".join(map(str, bins)))
     for q in quality:
         print("  %-10s %8d tris  %7.1f ms  %.3f s/Mtri (CPU %.3f)  SAH %.2f vs sweep %.2f "
               "(+%.2f%%)" % (q["mesh"], q["tris"], q["build_ms"], q["s_per_mtri"],

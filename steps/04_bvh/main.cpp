@@ -31,7 +31,7 @@ double processCpuSeconds() {
 
 struct TraceOptions {
     std::string mesh, rays, hits, builder = "sah";
-    int threads = 1, repeat = 1, bins = 16, width = 2;
+    int threads = 1, repeat = 1, bins = BvhBuildOptions{}.bins, width = 2;
     bool count = false;
 };
 
@@ -201,7 +201,7 @@ int main(int argc, char** argv) {
         app.add_option("--builder", builderName,
                        "hierarchy builder: midpoint, median, sah, sweep-sah, sbvh")
             ->capture_default_str();
-        int bins = 16;
+        int bins = BvhBuildOptions{}.bins;
         app.add_option("--bins", bins, "binned SAH: bins per axis")
             ->check(CLI::Range(2, 256))
             ->capture_default_str();

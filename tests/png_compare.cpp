@@ -3,11 +3,14 @@
 // apart), max_step (the largest channel difference in 8-bit steps) and distinct_colours
 // (of A). For tests that compare pictures written by programs (tests/windows_x11.py).
 // Bad input: one line on stderr, exit 1.
+#include <algorithm>
+#include <cstdint>
 #include <cstdio>
 #include <cstdlib>
 #include <exception>
 #include <set>
 #include <stdexcept>
+#include <vector>
 
 #include "core/image.hpp"
 

@@ -2,7 +2,7 @@
 """Every step's window on a real X server (Xvfb): the X11 and GLX path a student's desktop
 takes, beside the offscreen driver (EGL) that the doctest window cases use.
 
-usage: tests/windows_x11.py BUILD_DIR
+usage: tests/windows_x11.py BUILD_DIR PNG_COMPARE
 Each step program runs the same scripted frames and keys twice, once under xvfb-run with
 SDL_VIDEODRIVER=x11 (no fallback to another driver) and once with SDL_VIDEODRIVER=offscreen,
 and writes a screenshot each time. Checked: both exit 0; the X11 window has the default
@@ -18,7 +18,9 @@ import subprocess
 import sys
 import tempfile
 
-STEPS = ["01_triangle", "02_box", "03_aabb", "04_bvh", "05_efficiency", "06_raster"]
+ROOT = os.path.dirname(os.path.dirname(os.path.abspath(__file__)))
+# Every step folder of the tree; a step whose program was not built is a failure.
+STEPS = sorted(d for d in os.listdir(os.path.join(ROOT, "steps")) if d[:2].isdigit())
 # Orbit and move, which every step has. Step 05 first picks the full render for every frame
 # ("0"): its default preview adapts the resolution to the frame time, which differs by run.
 KEYS = {"05_efficiency": "0,Left,W,Up"}
@@ -31,7 +33,9 @@ MAX_DIFFERING = 0.01
 def screenshot(program, keys, driver, shot, work):
     """Runs the scripted window with the driver; None when it worked, else why not."""
     env = dict(os.environ, SDL_VIDEODRIVER=driver, ASAN_OPTIONS="detect_leaks=0")
-    cmd = [program, "--width", "160", "--height", "120", "--frames", "6", "--keys", keys, "--screenshot", shot]
+    # A small image keeps the frames quick; the window keeps its size, the image scaled.
+    cmd = [program, "--width", "160", "--height", "120", "--frames", "6", "--keys", keys,
+           "--screenshot", shot]
     if driver == "x11":
         cmd = ["xvfb-run", "-a", "-s", "-screen 0 1280x800x24"] + cmd
     try:
@@ -56,6 +60,8 @@ def main():
         for step in STEPS:
             program = os.path.join(build, "steps", step, step)
             if not os.path.exists(program):
+                print(f"FAIL  {step}: no program {program}")
+                failures += 1
                 continue
             x11, offscreen = (os.path.join(work, f"{step}-{d}.png") for d in ("x11", "offscreen"))
             keys = KEYS.get(step, DEFAULT_KEYS)

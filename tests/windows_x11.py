@@ -9,7 +9,7 @@ and writes a screenshot each time. Checked: both exit 0; the X11 window has the 
 size (960 x 720) and shows a picture (at least 200 distinct colours; a blank framebuffer
 has one); and it is the offscreen window's picture: at most 1% of the pixels differ by
 more than one 8-bit step (the panel's timings, such as "46.6 ms/frame", differ from run to
-run). Exit 77 (ctest: skipped) without xvfb-run (tools/deps.sh window).
+run). Exit 77 (ctest: skipped) without xvfb-run (tools/deps.sh test).
 """
 import json
 import os
@@ -53,7 +53,7 @@ def main():
         return 2
     build, compare = os.path.abspath(sys.argv[1]), os.path.abspath(sys.argv[2])
     if not shutil.which("xvfb-run"):
-        print("SKIP: no xvfb-run (tools/deps.sh window)")
+        print("SKIP: no xvfb-run (tools/deps.sh test)")
         return 77
     failures = 0
     with tempfile.TemporaryDirectory() as work:

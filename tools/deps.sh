@@ -1,6 +1,6 @@
 #!/usr/bin/env bash
 # Installs the Debian packages a workbook command needs, when they are missing.
-# usage: tools/deps.sh GROUP...   (groups: build test report slides fuzz grade bench window)
+# usage: tools/deps.sh GROUP...   (groups: build test report slides fuzz grade bench)
 # As root it runs apt-get; otherwise it prints the exact apt-get line and exits 1.
 # The group slides also installs the slides' npm packages (Marp, playwright-core) with
 # `npm ci --prefix slides` from slides/package-lock.json when they are missing or stale.
@@ -14,7 +14,7 @@ pkgs_for() {
       libtinyobjloader-dev libcli11-dev libimgui-dev nlohmann-json3-dev libgl-dev \
       libegl1 libgl1-mesa-dri
     ;;
-  test) echo python3 python3-yaml ;;
+  test) echo python3 python3-yaml xvfb xauth ;; # xvfb: the windows' X11 + GLX test
   report) echo python3 python3-matplotlib ;;
   slides)
     echo chromium
@@ -23,7 +23,6 @@ pkgs_for() {
   fuzz) echo clang libclang-rt-dev python3-hypothesis ;;
   grade) echo bubblewrap python3 ;;
   bench) echo libbenchmark-dev libembree-dev python3-numpy linux-perf ;; # perf: step 05 README
-  window) echo xvfb xauth ;; # a real X server without a screen: the windows' X11 + GLX path
   *)
     echo "tools/deps.sh: unknown group '$1'" >&2
     exit 2

@@ -1,15 +1,15 @@
-// The rays file of step 04's `trace` command (steps/04_bvh/trace.cpp parseRays, the bytes
-// readRays reads). Promise: the rays, or an InputError of one line that names the file;
-// a small accepted file is then traced against a tiny mesh through three hierarchies (SAH,
-// midpoint, 4-wide), each hit agreeing with brute force and lying in the ray's interval
-// (tmin > tmax: a miss), and HITS.bin written atomically and read back unchanged.
+// The rays file of step 04's `trace` command (steps/04_bvh/advanced/rays.cpp parseRays,
+// the bytes readRays reads). Promise: the rays, or an InputError of one line that names the
+// file; a small accepted file is then traced against a tiny mesh through three hierarchies
+// (SAH, midpoint, 4-wide), each hit agreeing with brute force and lying in the ray's
+// interval (tmin > tmax: a miss), and HITS.bin written atomically and read back unchanged.
 #include <unistd.h>
 
 #include <cstring>
 #include <filesystem>
 
-#include "04_bvh/bvh4.hpp"
-#include "04_bvh/trace.hpp"
+#include "04_bvh/advanced/bvh4.hpp"
+#include "04_bvh/advanced/rays.hpp"
 #include "core/exercise.hpp"
 #include "fuzz/fuzz_common.hpp"
 

@@ -1,22 +1,22 @@
-// Step 04's builder with spatial splits (steps/04_bvh/bvh_spatial.cpp) on fuzzed geometry.
-// Input: a byte of options, a byte of scale, then up to 48 triangles of 9 int16 each,
-// coordinates int16 * 2^(scale - 128) (clamped to 2^-120 .. 2^110): meshes from tiny to
-// near the float limit, each with 16 bits of resolution. (Raw float triples mixed
+// Step 04's builder with spatial splits (steps/04_bvh/advanced/bvh_spatial.cpp) on fuzzed
+// geometry. Input: a byte of options, a byte of scale, then up to 48 triangles of 9 int16
+// each, coordinates int16 * 2^(scale - 128) (clamped to 2^-120 .. 2^110): meshes from tiny
+// to near the float limit, each with 16 bits of resolution. (Raw float triples mixed
 // magnitudes 1e-125 to 1e37 in one mesh, where the float leaf test itself breaks down: see
-// step 04's README, "What is left".) Promises: the build ends, with a depth within the cap
-// and every triangle referenced; every vertex, edge midpoint and centroid of every
-// triangle lies in a leaf box that references it (the conservative clipping); rays aimed
-// at those points from three origins hit what brute force hits, in the binary tree and its
-// 8-wide collapse (where brute force's own hit is within the leaf test's error bound, see
-// trustworthy()); occlusion agrees.
+// steps/04_bvh/advanced/README.md, "Known limits".) Promises: the build ends, with a depth
+// within the cap and every triangle referenced; every vertex, edge midpoint and centroid
+// of every triangle lies in a leaf box that references it (the conservative clipping);
+// rays aimed at those points from three origins hit what brute force hits, in the binary
+// tree and its 8-wide collapse (where brute force's own hit is within the leaf test's
+// error bound, see trustworthy()); occlusion agrees.
 #include <algorithm>
 #include <cmath>
 #include <cstdint>
 #include <cstring>
 #include <vector>
 
-#include "04_bvh/bvh4.hpp"
-#include "04_bvh/trace.hpp"
+#include "04_bvh/advanced/build.hpp"
+#include "04_bvh/advanced/bvh4.hpp"
 #include "core/exercise.hpp"
 #include "fuzz/fuzz_common.hpp"
 
@@ -108,7 +108,7 @@ extern "C" int LLVMFuzzerTestOneInput(const uint8_t* data, size_t size) {
     if (mesh.triangles.empty()) return 0;
     Bvh bvh;
     try {
-        bvh = buildBvh(mesh, options);
+        bvh = buildEngineBvh(mesh, options);
     } catch (const NotImplemented&) {
         return 0;  // a starter kit: exercise 4.3 not solved yet
     }

@@ -7,7 +7,7 @@
 #include <memory>
 
 #include "01_triangle/triangle_grid.hpp"
-#include "04_bvh/trace.hpp"
+#include "04_bvh/advanced/rays.hpp"
 #include "core/app.hpp"
 #include "core/mesh.hpp"
 #include "core/render.hpp"

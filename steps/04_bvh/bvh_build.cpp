@@ -1,10 +1,7 @@
 // The builders: the recursive framework and the split rules (exercises 4.1 to 4.3).
 #include <algorithm>
 #include <cstdint>
-#include <numeric>
-#if defined(__linux__)
-#include <sys/mman.h>
-#endif
+#include <stdexcept>
 #if defined(__SSE2__)
 #include <immintrin.h>
 #endif
@@ -239,7 +236,7 @@ size_t partitionBinnedSah(std::span<BuildPrimitive> prims, const Bounds3f& nodeB
     // Partition with the same bin arithmetic, so every primitive lands where it was counted.
     // Lomuto's scheme without a branch: each primitive is swapped to the end of the left
     // part, which grows only when it goes left. (std::partition branches on every
-    // primitive and mispredicts often: this loop made the bunny's build 25% faster.)
+    // primitive, and the branch mispredicts often.)
     float axisLowest = lowest[bestAxis], axisScale = scale[bestAxis];
     size_t left = 0;
     for (BuildPrimitive& p : prims) {
@@ -252,120 +249,35 @@ size_t partitionBinnedSah(std::span<BuildPrimitive> prims, const Bounds3f& nodeB
     // END SOLUTION
 }
 
-size_t partitionSweepSah(std::span<BuildPrimitive> prims, const Bounds3f& nodeBounds,
-                         const BvhBuildOptions& options, float& cost) {
-    cost = kInfinity<float>;
-    size_t n = prims.size();
-    float nodeArea = nodeBounds.surfaceArea();
-    if (n < 2 || !(nodeArea > 0.0f)) return 0;
-    int bestAxis = -1;
-    size_t bestLeft = 0;
-    std::vector<float> rightArea(n);
-    for (int axis = 0; axis < 3; ++axis) {
-        std::sort(prims.begin(), prims.end(),
-                  [&](const BuildPrimitive& a, const BuildPrimitive& b) {
-                      return a.centroid[axis] < b.centroid[axis] ||
-                             (a.centroid[axis] == b.centroid[axis] && a.index < b.index);
-                  });
-        Bounds3f right;
-        for (size_t i = n; i-- > 1;) {
-            right.extend(prims[i].bounds.min);
-            right.extend(prims[i].bounds.max);
-            rightArea[i] = right.surfaceArea();
-        }
-        Bounds3f left;
-        for (size_t i = 1; i < n; ++i) {
-            left.extend(prims[i - 1].bounds.min);
-            left.extend(prims[i - 1].bounds.max);
-            // Only between different centroids: a plane must separate them.
-            if (prims[i - 1].centroid[axis] == prims[i].centroid[axis]) continue;
-            float c = options.traversalCost +
-                      options.intersectionCost *
-                          (left.surfaceArea() * float(i) + rightArea[i] * float(n - i)) / nodeArea;
-            if (c < cost) {
-                cost = c;
-                bestAxis = axis;
-                bestLeft = i;
-            }
-        }
-    }
-    if (bestAxis < 0) return 0;
-    std::sort(prims.begin(), prims.end(), [&](const BuildPrimitive& a, const BuildPrimitive& b) {
-        return a.centroid[bestAxis] < b.centroid[bestAxis] ||
-               (a.centroid[bestAxis] == b.centroid[bestAxis] && a.index < b.index);
-    });
-    return bestLeft;
-}
-
-// The build's large arrays (the primitives, the nodes, the leaf triangles: some 30 MB for
-// the motorbike) are first touched during the build, one 4 KiB page fault each: a third
-// of a one-shot build's CPU time on this machine (perf: 29,000 faults for the motorbike).
-// Where Linux offers transparent huge pages on request ("madvise" mode), an array of a
-// megabyte or more is placed on 2 MiB boundaries and asks for 2 MiB pages: 512x fewer
-// faults, and fewer TLB misses when tracing.
-void* allocateLarge(size_t bytes) {
-    if (bytes < kHugePage / 2) return ::operator new(bytes, std::align_val_t(64));
-    size_t rounded = (bytes + kHugePage - 1) & ~(kHugePage - 1);
-    void* p = ::operator new(rounded, std::align_val_t(kHugePage));
-#if defined(__linux__) && defined(MADV_HUGEPAGE)
-    madvise(p, rounded, MADV_HUGEPAGE);  // advice only: a failure changes nothing
-#endif
-    return p;
-}
-
-void freeLarge(void* p, size_t bytes) {
-    ::operator delete(p, std::align_val_t(bytes < kHugePage / 2 ? 64 : kHugePage));
-}
-
-void adviseHugePages(const void* data, size_t bytes) {
-#if defined(__linux__) && defined(MADV_HUGEPAGE)
-    uintptr_t begin = reinterpret_cast<uintptr_t>(data), end = begin + bytes;
-    begin = (begin + kHugePage - 1) & ~uintptr_t(kHugePage - 1);
-    end &= ~uintptr_t(kHugePage - 1);
-    if (end > begin) madvise(reinterpret_cast<void*>(begin), end - begin, MADV_HUGEPAGE);
-#else
-    (void)data, (void)bytes;
-#endif
-}
-
 namespace {
 
-// The build's working array of primitives, on huge pages (allocateLarge).
-template <typename T>
-struct LargeArrayAllocator {
-    using value_type = T;
-    LargeArrayAllocator() = default;
-    template <typename U>
-    LargeArrayAllocator(const LargeArrayAllocator<U>&) {}
-    T* allocate(size_t n) { return static_cast<T*>(allocateLarge(n * sizeof(T))); }
-    void deallocate(T* p, size_t n) { freeLarge(p, n * sizeof(T)); }
-    template <typename U>
-    bool operator==(const LargeArrayAllocator<U>&) const {
-        return true;
-    }
-};
-using BuildPrimitives = std::vector<BuildPrimitive, LargeArrayAllocator<BuildPrimitive>>;
+// The exercises' rules in the framework's shape.
+size_t midpointRule(std::span<BuildPrimitive> prims, const Bounds3f&, const Bounds3f& centroids,
+                    const BvhBuildOptions&, float&) {
+    return partitionMidpoint(prims, centroids);
+}
+size_t medianRule(std::span<BuildPrimitive> prims, const Bounds3f&, const Bounds3f& centroids,
+                  const BvhBuildOptions&, float&) {
+    return partitionMedian(prims, centroids);
+}
+
+using BuildPrimitives = std::pmr::vector<BuildPrimitive>;
 
 class BvhBuildJob {
 public:
-    BvhBuildJob(BuildPrimitives& prims, const BvhBuildOptions& options, Bvh& bvh)
-        : prims_(prims), options_(options), bvh_(bvh) {}
+    BvhBuildJob(BuildPrimitives& prims, const SplitRule& rule, const BvhBuildOptions& options,
+                Bvh& bvh)
+        : prims_(prims), rule_(rule), options_(options), bvh_(bvh) {}
 
     void build() {
         bvh_.nodes.clear();
         if (prims_.empty()) return;
-        bvh_.nodes.reserve(2 * prims_.size());  // on huge pages: see ChildPairAllocator
+        bvh_.nodes.reserve(2 * prims_.size());
         bvh_.nodes.emplace_back();
         buildNode(0, 0, prims_.size(), 0);
     }
 
 private:
-    bool isSah() const {
-        return options_.builder == BvhBuilder::BinnedSah ||
-               options_.builder == BvhBuilder::SweepSah ||
-               options_.builder == BvhBuilder::SpatialSah;
-    }
-
     void buildNode(uint32_t nodeIndex, size_t begin, size_t end, int depth) {
         PackedBounds packedBounds = PackedBounds::empty(), packedCentroids = PackedBounds::empty();
         for (size_t i = begin; i < end; ++i) {
@@ -377,7 +289,8 @@ private:
         BvhNode& node = bvh_.nodes[nodeIndex];
         node.boundsMin = bounds.min;
         node.boundsMax = bounds.max;
-        size_t leafLimit = size_t(std::max(1, isSah() ? options_.maxLeafSize : options_.leafSize));
+        size_t leafLimit =
+            size_t(std::max(1, rule_.sah ? options_.maxLeafSize : options_.leafSize));
         auto makeLeaf = [&] {
             BvhNode& leaf = bvh_.nodes[nodeIndex];
             leaf.leftFirst = uint32_t(begin);
@@ -385,28 +298,13 @@ private:
         };
         // The depth cap ends any recursion, whatever the split rule does.
         if (n == 1 || depth >= options_.maxDepth - 1) return makeLeaf();
-        if (!isSah() && n <= leafLimit) return makeLeaf();
+        if (!rule_.sah && n <= leafLimit) return makeLeaf();
 
         std::span<BuildPrimitive> range(prims_.data() + begin, n);
-        size_t left = 0;
         float splitCost = kInfinity<float>;
-        switch (options_.builder) {
-            case BvhBuilder::Midpoint:
-                left = partitionMidpoint(range, centroids);
-                break;
-            case BvhBuilder::Median:
-                left = partitionMedian(range, centroids);
-                break;
-            case BvhBuilder::BinnedSah:
-            case BvhBuilder::SpatialSah:  // bare bounds: nothing to clip
-                left = partitionBinnedSah(range, bounds, centroids, options_, splitCost);
-                break;
-            case BvhBuilder::SweepSah:
-                left = partitionSweepSah(range, bounds, options_, splitCost);
-                break;
-        }
+        size_t left = rule_.partition(range, bounds, centroids, options_, splitCost);
         bool split = left > 0 && left < n;
-        if (isSah() && n <= leafLimit && !(splitCost < options_.intersectionCost * float(n)))
+        if (rule_.sah && n <= leafLimit && !(splitCost < options_.intersectionCost * float(n)))
             return makeLeaf();
         if (!split) {
             // No rule separates them (identical centroids, a line of primitives): a leaf if
@@ -424,22 +322,21 @@ private:
     }
 
     BuildPrimitives& prims_;
+    const SplitRule& rule_;
     const BvhBuildOptions& options_;
     Bvh& bvh_;
 };
 
-void checkOptions(const BvhBuildOptions& options) {
-    if (options.bins < 2 || options.bins > kMaxBins)
-        throw InputError("SAH bins must be between 2 and 256");
-    if (options.maxDepth < 1 || options.maxDepth > kTraversalStackSize / 2)
-        throw InputError("BVH depth limit must be between 1 and 64");
+std::pmr::memory_resource* memoryOf(const BvhBuildOptions& options) {
+    return options.memory ? options.memory : std::pmr::get_default_resource();
 }
 
-Bvh buildFromPrimitives(BuildPrimitives& prims, const BvhBuildOptions& options) {
-    checkOptions(options);
-    Bvh bvh;
-    BvhBuildJob(prims, options, bvh).build();
-    reserveOnHugePages(bvh.primitiveIndices, prims.size());
+Bvh buildFromPrimitives(BuildPrimitives& prims, const SplitRule& rule,
+                        const BvhBuildOptions& options) {
+    checkBuildOptions(options);
+    Bvh bvh(memoryOf(options));
+    BvhBuildJob(prims, rule, options, bvh).build();
+    bvh.primitiveIndices.reserve(prims.size());
     for (const BuildPrimitive& p : prims) bvh.primitiveIndices.push_back(p.index);
     return bvh;
 }
@@ -452,40 +349,76 @@ void finishStats(const Bvh& bvh, const BvhBuildOptions& options, double ms, BvhB
 
 }  // namespace
 
+SplitRule splitRuleOf(BvhBuilder builder) {
+    switch (builder) {
+        case BvhBuilder::Midpoint:
+            return {midpointRule, false};
+        case BvhBuilder::Median:
+            return {medianRule, false};
+        case BvhBuilder::BinnedSah:
+            return {partitionBinnedSah, true};
+        default:
+            throw std::invalid_argument(std::string("builder '") + bvhBuilderName(builder) +
+                                        "' is the engine's (advanced/build.hpp)");
+    }
+}
+
+void checkBuildOptions(const BvhBuildOptions& options) {
+    if (options.bins < 2 || options.bins > kMaxBins)
+        throw InputError("SAH bins must be between 2 and 256");
+    if (options.maxDepth < 1 || options.maxDepth > kMaxBvhDepth)
+        throw InputError("BVH depth limit must be between 1 and 64");
+}
+
 Bvh buildBvh(std::span<const Bounds3f> primitiveBounds, const BvhBuildOptions& options,
              BvhBuildStats* stats) {
+    return buildBvh(primitiveBounds, splitRuleOf(options.builder), options, stats);
+}
+
+Bvh buildBvh(const Mesh& mesh, const BvhBuildOptions& options, BvhBuildStats* stats) {
+    return buildBvh(mesh, splitRuleOf(options.builder), options, stats);
+}
+
+Bvh buildBvh(std::span<const Bounds3f> primitiveBounds, const SplitRule& rule,
+             const BvhBuildOptions& options, BvhBuildStats* stats) {
     Stopwatch watch;
-    BuildPrimitives prims;
+    BuildPrimitives prims(memoryOf(options));
     prims.reserve(primitiveBounds.size());
     for (size_t i = 0; i < primitiveBounds.size(); ++i)
         prims.push_back({primitiveBounds[i], primitiveBounds[i].centroid(), uint32_t(i)});
-    Bvh bvh = buildFromPrimitives(prims, options);
+    Bvh bvh = buildFromPrimitives(prims, rule, options);
     finishStats(bvh, options, watch.milliseconds(), stats);
     return bvh;
 }
 
-Bvh buildBvh(const Mesh& mesh, const BvhBuildOptions& options, BvhBuildStats* stats) {
+Bvh buildBvh(const Mesh& mesh, const SplitRule& rule, const BvhBuildOptions& options,
+             BvhBuildStats* stats) {
+    Stopwatch watch;
+    BuildPrimitives prims = trianglePrimitives(mesh, memoryOf(options));
+    Bvh bvh = buildFromPrimitives(prims, rule, options);
+    fillLeafTriangles(bvh, mesh);
+    finishStats(bvh, options, watch.milliseconds(), stats);
+    return bvh;
+}
+
+std::pmr::vector<BuildPrimitive> trianglePrimitives(const Mesh& mesh,
+                                                    std::pmr::memory_resource* memory) {
     if (mesh.triangles.size() >= size_t(0xFFFFFFF0u))
         throw InputError("mesh has too many triangles for 32-bit indices");
-    Stopwatch watch;
-    BuildPrimitives prims;
+    std::pmr::vector<BuildPrimitive> prims(memory);
     prims.reserve(mesh.triangles.size());
     for (size_t i = 0; i < mesh.triangles.size(); ++i) {
         Bounds3f b;
         for (int k = 0; k < 3; ++k) b.extend(mesh.vertex(i, k));
         prims.push_back({b, b.centroid(), uint32_t(i)});
     }
-    Bvh bvh;
-    if (options.builder == BvhBuilder::SpatialSah) {
-        checkOptions(options);
-        bvh = buildSpatialSplitBvh(mesh, {prims.begin(), prims.end()}, options);
-    } else {
-        bvh = buildFromPrimitives(prims, options);
-    }
-    reserveOnHugePages(bvh.leafTriangles, bvh.primitiveIndices.size());
+    return prims;
+}
+
+void fillLeafTriangles(Bvh& bvh, const Mesh& mesh) {
+    bvh.leafTriangles.clear();
+    bvh.leafTriangles.reserve(bvh.primitiveIndices.size());
     for (uint32_t t : bvh.primitiveIndices) bvh.leafTriangles.push_back(leafTriangleOf(mesh, t));
-    finishStats(bvh, options, watch.milliseconds(), stats);
-    return bvh;
 }
 
 LeafTriangle leafTriangleOf(const Mesh& mesh, size_t triangle) {

@@ -119,7 +119,7 @@ bool boxIntersectsFrustumExact(const Frustum& frustum, const Bounds3f& box) {
 }
 
 std::vector<uint32_t> cullHierarchy(const Bvh& bvh, const Frustum& frustum, CullTest test,
-                                    CullCounts* counts) {
+                                    CullCounts* counts, bool classify) {
     std::vector<uint32_t> visible;
     if (bvh.empty()) return visible;
     CullCounts local;
@@ -134,7 +134,8 @@ std::vector<uint32_t> cullHierarchy(const Bvh& bvh, const Frustum& frustum, Cull
             continue;
         }
         ++local.kept;
-        if (counts && !boxIntersectsFrustumExact(frustum, node.bounds())) ++local.wronglyKept;
+        if (counts && classify && !boxIntersectsFrustumExact(frustum, node.bounds()))
+            ++local.wronglyKept;
         if (node.isLeaf()) {
             ++local.keptLeaves;
             for (uint32_t s = node.leftFirst; s < node.leftFirst + node.count; ++s) {

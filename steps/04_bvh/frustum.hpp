@@ -65,10 +65,12 @@ struct CullCounts {
 
 // Walks the hierarchy from the root, skipping the subtree of every culled box, and
 // returns the primitives (triangle indices in file order) of the leaves it keeps: what a
-// rasterizer draws, each once (leaves of a tree with spatial splits share triangles), in
-// the order first met. With `counts`, also classifies every kept box with the exact test.
+// rasterizer draws (step 06), each once (leaves of a tree with spatial splits share
+// triangles), in the order first met. With `counts`, also counts the walk, and with
+// `classify` every kept box with the exact test too (wronglyKept; it costs more than the
+// walk).
 std::vector<uint32_t> cullHierarchy(const Bvh& bvh, const Frustum& frustum, CullTest test,
-                                    CullCounts* counts = nullptr);
+                                    CullCounts* counts = nullptr, bool classify = true);
 
 // For drawing: the test's verdict on every node (visited or not).
 enum class NodeVisibility : uint8_t { NotVisited, Culled, Kept, WronglyKept };

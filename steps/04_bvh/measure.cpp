@@ -1,7 +1,11 @@
 #include "04_bvh/measure.hpp"
 
-#include "01_triangle/measure.hpp"
-#include "04_bvh/bvh4.hpp"
+#include <iostream>
+
+#include "04_bvh/advanced/batch.hpp"
+#include "04_bvh/advanced/build.hpp"
+#include "04_bvh/advanced/rays.hpp"
+#include "core/app.hpp"
 #include "core/timing.hpp"
 
 namespace boxes {
@@ -53,14 +57,14 @@ Table measureBuilds(const NamedMesh& mesh, int bins, int repeats) {
              "the full-sweep SAH tree (every centroid a candidate plane); binned SAH with " +
              std::to_string(bins) + " bins";
     BvhBuildStats sweep;
-    buildBvh(*mesh.mesh, optionsFor(BvhBuilder::SweepSah, bins), &sweep);
+    buildEngineBvh(*mesh.mesh, optionsFor(BvhBuilder::SweepSah, bins), &sweep);
     for (BvhBuilder builder : {BvhBuilder::Midpoint, BvhBuilder::Median, BvhBuilder::BinnedSah,
                                BvhBuilder::SweepSah, BvhBuilder::SpatialSah}) {
         std::vector<double> ms;
         BvhBuildStats s;
         int n = builder == BvhBuilder::SweepSah || builder == BvhBuilder::SpatialSah ? 1 : repeats;
         for (int i = 0; i < n; ++i) {
-            buildBvh(*mesh.mesh, optionsFor(builder, bins), &s);
+            buildEngineBvh(*mesh.mesh, optionsFor(builder, bins), &s);
             ms.push_back(s.buildMs);
         }
         double median = summarize(ms).median;
@@ -95,7 +99,7 @@ Table measureTraceSpeed(const NamedMesh& mesh, size_t rays, size_t bruteForceRay
     }
     for (BvhBuilder builder : kExerciseBuilders) {
         BvhBuildStats stats;
-        Bvh bvh = buildBvh(*mesh.mesh, optionsFor(builder, bins), &stats);
+        Bvh bvh = buildEngineBvh(*mesh.mesh, optionsFor(builder, bins), &stats);
         for (size_t k = 0; k < sets.size(); ++k) {
             double mrays = traceMrays(bvh, sets[k], repeats, 1);
             std::vector<TraceHit> hits;
@@ -122,7 +126,7 @@ Table measureThreads(const NamedMesh& mesh, size_t rays, int repeats, uint64_t s
              std::to_string(repeats) +
              " runs; 'control': a loop that touches no memory, split the same way (millions of "
              "iterations per second): the speed-up two threads can have on this machine now";
-    Bvh bvh = buildBvh(*mesh.mesh, optionsFor(BvhBuilder::BinnedSah, 16));
+    Bvh bvh = buildEngineBvh(*mesh.mesh, optionsFor(BvhBuilder::BinnedSah, 16));
     for (RayKind kind : {RayKind::Primary, RayKind::Diffuse}) {
         std::vector<Ray> set = makeRays(*mesh.mesh, kind, rays, seed);
         double one = traceMrays(bvh, set, repeats, 1), two = traceMrays(bvh, set, repeats, 2);
@@ -133,60 +137,43 @@ Table measureThreads(const NamedMesh& mesh, size_t rays, int repeats, uint64_t s
     return t;
 }
 
-Table measureBvhCracks(const std::vector<NamedMesh>& meshes, size_t raysPerFeature, uint64_t seed) {
+Table measureTradeoff(const Table& traceSpeed) {
     Table t;
-    t.id = "bvh_cracks";
-    t.title = "Cracks through the hierarchy: rays aimed at shared edges and vertices";
-    t.columns = {"mesh", "builder", "feature", "rays", "cracks", "differ from brute force"};
-    t.note =
-        "a crack: a ray that some triangle at the feature hits, for which the hierarchy "
-        "reports nothing as near; watertight leaf test, conservative box test; 'differ' "
-        "over the first 200 rays per row against brute force";
-    for (const NamedMesh& m : meshes) {
-        CrackRaySet set = makeCrackRays(*m.mesh, raysPerFeature, raysPerFeature, seed);
-        // The exercise builders, the SAH with spatial splits (whose split planes cut
-        // triangles, edges and vertices included), then the binned SAH tree collapsed to 4-
-        // and 8-wide nodes (bvh4.hpp).
-        struct Variant {
-            BvhBuilder builder;
-            int width;
-        };
-        std::vector<Variant> variants;
-        for (BvhBuilder b : kExerciseBuilders) variants.push_back({b, 2});
-        variants.push_back({BvhBuilder::SpatialSah, 2});
-        variants.push_back({BvhBuilder::BinnedSah, 4});
-        variants.push_back({BvhBuilder::BinnedSah, 8});
-        for (auto [builder, width] : variants) {
-            Bvh bvh = buildBvh(*m.mesh, optionsFor(builder, 16));
-            Bvh4 bvh4 = width == 4 ? collapseToBvh4(bvh) : Bvh4{};
-            Bvh8 bvh8 = width == 8 ? collapseToBvh8(bvh) : Bvh8{};
-            for (int feature = 0; feature < 2; ++feature) {
-                const auto& rays = feature == 0 ? set.edgeRays : set.vertexRays;
-                size_t cracks = 0, differ = 0;
-                for (const CrackRay& cr : rays) {
-                    TraceHit h = width == 4   ? traceNearest(bvh4, cr.ray)
-                                 : width == 8 ? traceNearest(bvh8, cr.ray)
-                                              : traceNearest(bvh, cr.ray);
-                    float target = kInfinity<float>;
-                    WatertightRay w(cr.ray);
-                    for (uint32_t tri : cr.triangles) {
-                        LeafTriangle lt = leafTriangleOf(*m.mesh, tri);
-                        float tmax = cr.ray.tmax;
-                        if (intersectLeafTriangle(w, lt, tmax)) target = std::min(target, tmax);
-                    }
-                    cracks += target < kInfinity<float> && !(h.t <= target);
-                    if (&cr - rays.data() < 200)
-                        differ += !hitsAgree(h, traceBruteForce(*m.mesh, cr.ray));
-                }
-                t.row({m.name,
-                       width > 2 ? "sah " + std::to_string(width) + "-wide"
-                                 : std::string(bvhBuilderName(builder)),
-                       std::string(feature == 0 ? "edges" : "vertices"), (long long)rays.size(),
-                       (long long)cracks, (long long)differ});
-            }
-        }
+    t.id = "bvh_tradeoff";
+    t.title = "Build time against trace speed (primary rays, one thread)";
+    t.columns = {"builder", "build ms", "Mrays/s"};
+    for (const auto& row : traceSpeed.rows) {
+        std::string name = std::get<std::string>(row[0]);
+        if (!name.ends_with(" primary")) continue;
+        t.row(
+            {name.substr(0, name.size() - 8), std::get<double>(row[3]), std::get<double>(row[2])});
     }
     return t;
+}
+
+void addMeasurements(Report& report, const NamedMesh& mesh, const Bvh& bvh,
+                     const MeasureSettings& settings) {
+    std::cerr << "04_bvh: measuring builds...\n";
+    report.add(measureBuilds(mesh, settings.bins, 5));
+    std::cerr << "04_bvh: measuring traversal...\n";
+    Table speed =
+        measureTraceSpeed(mesh, settings.traceRays, 1000, 5, settings.seed, settings.bins);
+    report.add(speed);
+    report.add(measureThreads(mesh, settings.traceRays, 5, settings.seed));
+    std::cerr << "04_bvh: counting cracks...\n";
+    Mesh sh1 = loadObj(settings.dataDir + "/meshes/sh1.obj");
+    Mesh bunny =
+        mesh.name == "bunny" ? *mesh.mesh : loadObj(settings.dataDir + "/meshes/bunny.obj");
+    report.add(
+        measureBvhCracks({{"bunny", &bunny}, {"sh1", &sh1}}, settings.crackRays, settings.seed));
+    std::cerr << "04_bvh: culling...\n";
+    report.add(measureCulling(mesh, bvh, 8));
+    report.add(measureTradeoff(speed));
+    report.plots.push_back({{"table", "bvh_tradeoff"},
+                            {"x", "build ms"},
+                            {"y", "Mrays/s"},
+                            {"series", "builder"},
+                            {"title", "Builders: build time against trace speed"}});
 }
 
 CullingView cullingView(const Bounds3f& bounds, int index, int count, float aspect) {
@@ -310,6 +297,19 @@ void drawCullingMap(Image& image, int x0, int width, const Bvh& bvh, const Frust
     for (const auto& e : edges)
         line(image, x0, width, toMap(k[size_t(e[0])]), toMap(k[size_t(e[1])]),
              Vec3(0.4f, 0.7f, 1.0f));
+}
+
+void addCullingMap(Report& report, const Bvh& bvh, const std::string& png, int width, int height,
+                   Vec3 up) {
+    CullingView v = cullingView(bvh.bounds(), 1, 8, float(width) / float(height));
+    Frustum f = makeFrustum(v.camera, v.nearDistance, v.farDistance);
+    Image map(width, height);
+    drawCullingMap(map, 0, width, bvh, f, CullTest::Planes, 6, up);
+    std::string path = pngWithSuffix(png, "-cull");
+    map.writePng(path);
+    report.images.push_back({path,
+                             "the hierarchy from above (depth 6): grey culled, green kept, red "
+                             "wrongly kept by the plane test; the frustum in blue"});
 }
 
 }  // namespace boxes

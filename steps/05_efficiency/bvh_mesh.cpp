@@ -2,6 +2,8 @@
 
 #include <algorithm>
 
+#include "04_bvh/advanced/build.hpp"
+
 namespace boxes {
 
 namespace {
@@ -16,7 +18,7 @@ BvhBuildOptions labBuildOptions() {
 }  // namespace
 
 LabBvhMesh::LabBvhMesh(const Mesh& mesh, int material)
-    : mesh_(mesh), material_(material), bvh_(buildBvh(mesh, labBuildOptions(), &stats_)) {
+    : mesh_(mesh), material_(material), bvh_(buildEngineBvh(mesh, labBuildOptions(), &stats_)) {
     for (const LeafTriangle& t : bvh_.leafTriangles) {
         TriangleVertices v{t.a, t.b, t.c};
         vertices_.push_back(v);

@@ -16,29 +16,15 @@ std::vector<uint32_t> FrustumCuller::visibleTriangles(const Camera& camera, doub
                                                       CullTest test, CullStats& stats) const {
     Stopwatch watch;
     stats = CullStats{};
-    std::vector<uint32_t> visible;
-    if (bvh_.empty()) return visible;
+    if (bvh_.empty()) return {};
     const Frustum frustum = makeFrustum(camera, float(near), float(far));
-    // Depth first from the root, a culled box's subtree never visited (step 04's walk,
-    // counting boxes without its exact classification, which costs more than drawing).
-    std::vector<uint32_t> stack = {0};
-    while (!stack.empty()) {
-        const BvhNode& node = bvh_.nodes[stack.back()];
-        stack.pop_back();
-        ++stats.boxesVisited;
-        if (boxCulled(frustum, node.bounds(), test)) {
-            ++stats.boxesCulled;
-            continue;
-        }
-        ++stats.boxesKept;
-        if (node.isLeaf()) {
-            for (uint32_t s = node.leftFirst; s < node.leftFirst + node.count; ++s)
-                visible.push_back(bvh_.primitiveIndices[s]);
-        } else {
-            stack.push_back(node.leftFirst + 1);
-            stack.push_back(node.leftFirst);
-        }
-    }
+    // Step 04's walk, counting boxes without its exact classification (which costs more
+    // than drawing).
+    CullCounts counts;
+    std::vector<uint32_t> visible = cullHierarchy(bvh_, frustum, test, &counts, false);
+    stats.boxesVisited = counts.visited;
+    stats.boxesCulled = counts.culled;
+    stats.boxesKept = counts.kept;
     std::sort(visible.begin(), visible.end());
     stats.trianglesKept = visible.size();
     stats.milliseconds = watch.milliseconds();

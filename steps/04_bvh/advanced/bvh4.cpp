@@ -1,7 +1,9 @@
-#include "04_bvh/bvh4.hpp"
+#include "04_bvh/advanced/bvh4.hpp"
 
 #include <algorithm>
 #include <cmath>
+
+#include "04_bvh/advanced/memory.hpp"
 
 namespace boxes {
 
@@ -177,8 +179,7 @@ BvhWide<W> collapseToWide(const Bvh& binary) {
     collapser.computeCosts(0);
     // Reserved for leaves padded to whole packets (more only makes a vector grow), on huge
     // pages. What is never touched costs no memory, so there is no shrink_to_fit at the
-    // end: it copied every array once more, into pages faulted in one by one (with it the
-    // motorbike's collapse took about 200 ms, without it and on huge pages about 60).
+    // end: it would copy every array once more, into pages faulted in one by one.
     size_t slots = binary.primitiveIndices.size();
     bool triangles = !binary.leafTriangles.empty();
     reserveOnHugePages(wide.primitiveIndices, slots + slots / 2);

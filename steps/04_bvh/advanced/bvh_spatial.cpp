@@ -1,4 +1,4 @@
-// Not an exercise: the binned SAH with spatial splits (Stich, Friedrich, Dietrich 2009,
+// Step 04's engine: the binned SAH with spatial splits (Stich, Friedrich, Dietrich 2009,
 // "Spatial splits in bounding volume hierarchies"). Where the two children of the best
 // object split overlap a lot (long thin triangles, large triangles crossing a room), the
 // builder also tries planes that cut triangles: a triangle crossing the plane goes to
@@ -12,7 +12,7 @@
 #include <algorithm>
 #include <cmath>
 
-#include "04_bvh/bvh.hpp"
+#include "04_bvh/advanced/build.hpp"
 
 namespace boxes {
 
@@ -279,7 +279,7 @@ private:
 
 Bvh buildSpatialSplitBvh(const Mesh& mesh, std::vector<BuildPrimitive> refs,
                          const BvhBuildOptions& options) {
-    Bvh bvh;
+    Bvh bvh(options.memory ? options.memory : std::pmr::get_default_resource());
     SpatialBuildJob(mesh, options, bvh).build(std::move(refs));
     return bvh;
 }

@@ -1,5 +1,4 @@
-// Step 04, the advanced variant (not an exercise): a 4-wide (and an 8-wide) hierarchy
-// traversed with SIMD.
+// Step 04's engine: a 4-wide (and an 8-wide) hierarchy traversed with SIMD.
 //
 // Layout (as Embree's BVH4 and tinybvh's BVH4): one node holds its four children's boxes
 // "structure of arrays", minimum x of the four children in one float[4], then minimum y, ...,
@@ -30,8 +29,8 @@
 #include <cstdint>
 #include <vector>
 
+#include "04_bvh/advanced/batch.hpp"
 #include "04_bvh/bvh.hpp"
-#include "04_bvh/trace.hpp"
 
 #if defined(__SSE2__)
 #include <emmintrin.h>
@@ -89,9 +88,8 @@ using Bvh8 = BvhWide<8>;
 // Collapses a binary hierarchy: its leaves are kept, a subtree of at most
 // kBvh4MergedLeafSize primitives may become one leaf, and the slots of every leaf are
 // regrouped into packets. The collapse's SAH counts a wide node's test as
-// kCollapseNodeCost packet tests: with 1, 2, 3 and 4, paired rounds on the three meshes
-// put 2 first for 8-wide nodes (1.00-1.12x the greedy collapse that opened the largest
-// child first, 1.08-1.12x on five of six ray sets) and level for 4-wide nodes (0.96-1.04x).
+// kCollapseNodeCost packet tests: of 1, 2, 3 and 4, 2 traced fastest with 8-wide nodes
+// and as fast as any with 4-wide ones (advanced/README.md).
 constexpr uint32_t kBvh4MergedLeafSize = 8;
 constexpr double kCollapseNodeCost = 2.0;
 template <int W>
@@ -313,7 +311,7 @@ uint32_t traverseNearest4Leaves(const BvhWide<W>& bvh, const TraversalRay& trave
                 mask |= 1 << second;
                 // Three or more: sorted farthest first onto the stack, the nearest descended.
                 // Sorted where they go, on the stack: a separate array and its copy (a `rep
-                // movsq`) cost the 4-wide loop 6-13% (paired rounds, stop 22).
+                // movsq`) were slower.
                 Entry* hit = stack + stackSize;
                 hit[0] = {node.child[first], node.count[first], t[first]};
                 int hits = 1;
@@ -539,6 +537,12 @@ inline TraceHit traceNearest(const BvhWide<W>& bvh, const Ray& ray, Counter coun
     });
     if (slot == kTraversalMiss) return {};
     return {tClosest, bvh.primitiveIndices[slot]};
+}
+
+// The batch loop's nearest hit (batch.hpp).
+template <bool kAvx, int W>
+inline TraceHit batchNearestHit(const BvhWide<W>& bvh, const Ray& ray) {
+    return traceNearest<kAvx>(bvh, ray);
 }
 
 template <int W>

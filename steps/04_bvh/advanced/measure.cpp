@@ -1,0 +1,69 @@
+#include "04_bvh/advanced/measure.hpp"
+
+#include <algorithm>
+
+#include "01_triangle/measure.hpp"
+#include "04_bvh/advanced/build.hpp"
+#include "04_bvh/advanced/bvh4.hpp"
+
+namespace boxes {
+
+Table measureBvhCracks(const std::vector<NamedMesh>& meshes, size_t raysPerFeature, uint64_t seed) {
+    Table t;
+    t.id = "bvh_cracks";
+    t.title = "Cracks through the hierarchy: rays aimed at shared edges and vertices";
+    t.columns = {"mesh", "builder", "feature", "rays", "cracks", "differ from brute force"};
+    t.note =
+        "a crack: a ray that some triangle at the feature hits, for which the hierarchy "
+        "reports nothing as near; watertight leaf test, conservative box test; 'differ' "
+        "over the first 200 rays per row against brute force";
+    for (const NamedMesh& m : meshes) {
+        CrackRaySet set = makeCrackRays(*m.mesh, raysPerFeature, raysPerFeature, seed);
+        // The exercise builders, the SAH with spatial splits (whose split planes cut
+        // triangles, edges and vertices included), then the binned SAH tree collapsed to 4-
+        // and 8-wide nodes (bvh4.hpp).
+        struct Variant {
+            BvhBuilder builder;
+            int width;
+        };
+        std::vector<Variant> variants;
+        for (BvhBuilder b : kExerciseBuilders) variants.push_back({b, 2});
+        variants.push_back({BvhBuilder::SpatialSah, 2});
+        variants.push_back({BvhBuilder::BinnedSah, 4});
+        variants.push_back({BvhBuilder::BinnedSah, 8});
+        for (auto [builder, width] : variants) {
+            BvhBuildOptions options;
+            options.builder = builder;
+            Bvh bvh = buildEngineBvh(*m.mesh, options);
+            Bvh4 bvh4 = width == 4 ? collapseToBvh4(bvh) : Bvh4{};
+            Bvh8 bvh8 = width == 8 ? collapseToBvh8(bvh) : Bvh8{};
+            for (int feature = 0; feature < 2; ++feature) {
+                const auto& rays = feature == 0 ? set.edgeRays : set.vertexRays;
+                size_t cracks = 0, differ = 0;
+                for (const CrackRay& cr : rays) {
+                    TraceHit h = width == 4   ? traceNearest(bvh4, cr.ray)
+                                 : width == 8 ? traceNearest(bvh8, cr.ray)
+                                              : traceNearest(bvh, cr.ray);
+                    float target = kInfinity<float>;
+                    WatertightRay w(cr.ray);
+                    for (uint32_t tri : cr.triangles) {
+                        LeafTriangle lt = leafTriangleOf(*m.mesh, tri);
+                        float tmax = cr.ray.tmax;
+                        if (intersectLeafTriangle(w, lt, tmax)) target = std::min(target, tmax);
+                    }
+                    cracks += target < kInfinity<float> && !(h.t <= target);
+                    if (&cr - rays.data() < 200)
+                        differ += !hitsAgree(h, traceBruteForce(*m.mesh, cr.ray));
+                }
+                t.row({m.name,
+                       width > 2 ? "sah " + std::to_string(width) + "-wide"
+                                 : std::string(bvhBuilderName(builder)),
+                       std::string(feature == 0 ? "edges" : "vertices"), (long long)rays.size(),
+                       (long long)cracks, (long long)differ});
+            }
+        }
+    }
+    return t;
+}
+
+}  // namespace boxes

@@ -1,0 +1,154 @@
+// Step 04: the leaf test, the watertight ray/triangle test (Woop, Benthin and Wald, JCGT
+// 2013) prepared once per ray. Not an exercise: the hierarchy's hits must not depend on
+// step 01's exercise 1.5, and its hot loop needs the per-ray set-up below.
+#pragma once
+
+#include <cmath>
+#include <cstdint>
+#include <limits>
+#include <utility>
+
+#include "04_bvh/bvh.hpp"
+#include "core/ray.hpp"
+
+namespace boxes {
+
+// The ray's part of the test. A performance copy of step 01's exercise 1.5 (which stays
+// the teaching version): the permutation and shear are computed once per ray instead of
+// per triangle, and the arithmetic per triangle is otherwise the same, operation for
+// operation, so the two give bit-identical t. The hierarchy's hot loop calls this one,
+// inlined.
+struct WatertightRay {
+    Vec3 origin;
+    int kx, ky, kz;
+    float sx, sy, sz;
+    float tmin;
+
+    explicit WatertightRay(const Ray& ray) : origin(ray.origin), tmin(ray.tmin) {
+        Vec3 absD = glm::abs(ray.direction);
+        kz = maxDimension(absD);
+        kx = (kz + 1) % 3;
+        ky = (kx + 1) % 3;
+        if ((&ray.direction.x)[kz] < 0.0f) std::swap(kx, ky);
+        const float* d = &ray.direction.x;
+        sx = d[kx] / d[kz];
+        sy = d[ky] / d[kz];
+        sz = 1.0f / d[kz];
+    }
+};
+
+// The six axis orders (kz the dominant axis, kx and ky swapped for a negative d[kz]),
+// as compile-time constants: the leaf test then reads components from registers instead
+// of through a run-time index (a store and an indexed load per component), and the
+// traversal is instantiated once per order, chosen once per ray (withWatertightAxes).
+template <int Kz, bool Swap>
+struct WatertightAxes {
+    static constexpr int kz = Kz;
+    static constexpr int kx = Swap ? (Kz + 2) % 3 : (Kz + 1) % 3;
+    static constexpr int ky = Swap ? (Kz + 1) % 3 : (Kz + 2) % 3;
+};
+
+// Calls f(WatertightAxes<...>{}) with the ray's axis order.
+template <typename F>
+decltype(auto) withWatertightAxes(const WatertightRay& r, F&& f) {
+    bool swap = r.kx != (r.kz + 1) % 3;
+    switch (r.kz * 2 + int(swap)) {
+        case 0:
+            return f(WatertightAxes<0, false>{});
+        case 1:
+            return f(WatertightAxes<0, true>{});
+        case 2:
+            return f(WatertightAxes<1, false>{});
+        case 3:
+            return f(WatertightAxes<1, true>{});
+        case 4:
+            return f(WatertightAxes<2, false>{});
+        default:
+            return f(WatertightAxes<2, true>{});
+    }
+}
+
+// The same test in double, for the rare triangle whose float edge functions overflow
+// (coordinates beyond about 1e19 from the ray origin: their products pass 3.4e38, and
+// inf - inf is NaN). The sheared vertices are still finite floats; in double the products
+// cannot overflow, so such a triangle is hit instead of silently missed.
+template <typename Axes>
+[[gnu::noinline]] bool intersectLeafTriangleDouble(Axes, const WatertightRay& r,
+                                                   const LeafTriangle& tri, float& tmax,
+                                                   float* uOut, float* vOut) {
+    constexpr int kx = Axes::kx, ky = Axes::ky, kz = Axes::kz;
+    const glm::dvec3 o(r.origin);
+    const glm::dvec3 av = glm::dvec3(tri.a) - o, bv = glm::dvec3(tri.b) - o,
+                     cv = glm::dvec3(tri.c) - o;
+    const double sx = r.sx, sy = r.sy, sz = r.sz;
+    double ax = av[kx] - sx * av[kz], ay = av[ky] - sy * av[kz];
+    double bx = bv[kx] - sx * bv[kz], by = bv[ky] - sy * bv[kz];
+    double cx = cv[kx] - sx * cv[kz], cy = cv[ky] - sy * cv[kz];
+    double u = cx * by - cy * bx, v = ax * cy - ay * cx, w = bx * ay - by * ax;
+    if ((u < 0.0 || v < 0.0 || w < 0.0) && (u > 0.0 || v > 0.0 || w > 0.0)) return false;
+    double det = u + v + w;
+    if (det == 0.0 || !std::isfinite(det)) return false;
+    float t = float((u * sz * av[kz] + v * sz * bv[kz] + w * sz * cv[kz]) / det);
+    if (!(t >= r.tmin && t <= tmax && std::fabs(t) <= std::numeric_limits<float>::max()))
+        return false;
+    tmax = t;
+    if (uOut) *uOut = float(v / det);
+    if (vOut) *vOut = float(w / det);
+    return true;
+}
+
+// A hit in [ray.tmin, tmax] lowers tmax to it; (u, v) are the barycentrics of b and c.
+// Axes must be the ray's order (r.kx, r.ky, r.kz); the arithmetic is exercise 1.5's.
+template <typename Axes>
+inline bool intersectLeafTriangle(Axes, const WatertightRay& r, const LeafTriangle& tri,
+                                  float& tmax, float* uOut = nullptr, float* vOut = nullptr) {
+    constexpr int kx = Axes::kx, ky = Axes::ky, kz = Axes::kz;
+    const Vec3 av = tri.a - r.origin, bv = tri.b - r.origin, cv = tri.c - r.origin;
+    const float *a = &av.x, *b = &bv.x, *c = &cv.x;
+    float ax = a[kx] - r.sx * a[kz], ay = a[ky] - r.sy * a[kz];
+    float bx = b[kx] - r.sx * b[kz], by = b[ky] - r.sy * b[kz];
+    float cx = c[kx] - r.sx * c[kz], cy = c[ky] - r.sy * c[kz];
+    float u = cx * by - cy * bx;
+    float v = ax * cy - ay * cx;
+    float w = bx * ay - by * ax;
+    // Exactly zero: recompute in double so neighbours agree on the shared edge.
+    if (u == 0.0f || v == 0.0f || w == 0.0f) [[unlikely]] {
+        u = float(double(cx) * double(by) - double(cy) * double(bx));
+        v = float(double(ax) * double(cy) - double(ay) * double(cx));
+        w = float(double(bx) * double(ay) - double(by) * double(ax));
+    }
+    float det = u + v + w;  // not finite exactly when an edge function overflowed
+    if (!std::isfinite(det)) [[unlikely]]
+        return intersectLeafTriangleDouble(Axes{}, r, tri, tmax, uOut, vOut);
+    // Bitwise | and & on the comparisons: one branch, mostly taken (most tests miss),
+    // instead of a chain of unpredictable ones.
+    bool negative = (u < 0.0f) | (v < 0.0f) | (w < 0.0f);
+    bool positive = (u > 0.0f) | (v > 0.0f) | (w > 0.0f);
+    if ((negative & positive) | (det == 0.0f)) return false;
+    float az = r.sz * a[kz], bz = r.sz * b[kz], cz = r.sz * c[kz];
+    float tScaled = u * az + v * bz + w * cz;
+    // Outside the normal range the products may have underflowed to zeros whose signs no
+    // longer add up (t = -0 for a triangle behind the ray, |d| = 1e28) or overflowed (t =
+    // inf for a triangle 3e38 away): both found by fuzz_rays. Decide in double instead.
+    float magnitude = std::fabs(tScaled);
+    if (!(magnitude >= std::numeric_limits<float>::min() &&
+          magnitude <= std::numeric_limits<float>::max())) [[unlikely]]
+        return intersectLeafTriangleDouble(Axes{}, r, tri, tmax, uOut, vOut);
+    float t = tScaled / det;
+    // A hit beyond the float range (t = +-inf) is a miss: HITS.bin has no t for it.
+    if (!(t >= r.tmin && t <= tmax && std::fabs(t) <= std::numeric_limits<float>::max()))
+        return false;
+    tmax = t;
+    if (uOut) *uOut = v / det;
+    if (vOut) *vOut = w / det;
+    return true;
+}
+
+// The same with the axis order chosen at run time (one switch per call: not for loops).
+inline bool intersectLeafTriangle(const WatertightRay& r, const LeafTriangle& tri, float& tmax,
+                                  float* uOut = nullptr, float* vOut = nullptr) {
+    return withWatertightAxes(
+        r, [&](auto axes) { return intersectLeafTriangle(axes, r, tri, tmax, uOut, vOut); });
+}
+
+}  // namespace boxes

@@ -17,6 +17,7 @@
 
 #include "04_bvh/advanced/build.hpp"
 #include "04_bvh/advanced/bvh4.hpp"
+#include "04_bvh/advanced/rays.hpp"
 #include "core/exercise.hpp"
 #include "fuzz/fuzz_common.hpp"
 

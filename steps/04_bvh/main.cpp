@@ -8,6 +8,7 @@
 
 #include "04_bvh/advanced/build.hpp"
 #include "04_bvh/advanced/commands.hpp"
+#include "04_bvh/culling_map.hpp"
 #include "04_bvh/measure.hpp"
 #include "core/app.hpp"
 #include "core/orbit.hpp"
@@ -15,10 +16,8 @@
 
 using namespace boxes;
 
-namespace {
-
 // The scene's mesh through a hierarchy of `options.builder` (the engine builds every one).
-std::shared_ptr<MeshBvhGeometry> meshGeometry(Scene& scene, const BvhBuildOptions& options) {
+static std::shared_ptr<MeshBvhGeometry> meshGeometry(Scene& scene, const BvhBuildOptions& options) {
     scene.geometries.clear();
     if (!scene.hasMesh()) return nullptr;
     BvhBuildStats stats;
@@ -28,21 +27,6 @@ std::shared_ptr<MeshBvhGeometry> meshGeometry(Scene& scene, const BvhBuildOption
     scene.geometries.push_back(geometry);
     return geometry;
 }
-
-// The window's right half: the hierarchy from above, culled by the left view's frustum
-// (far plane through the mesh's centre, or 3x as far: it cuts the mesh).
-void drawMap(Image& image, int x0, const Bvh& bvh, const Camera& camera, float farScale,
-             CullTest test, int level, Vec3 up, CullCounts counts[2]) {
-    Bounds3f bounds = bvh.bounds();
-    float radius = 0.5f * glm::length(bounds.diagonal());
-    float centre = glm::dot(bounds.centroid() - camera.eye, glm::normalize(camera.view));
-    Frustum f = makeFrustum(camera, 0.01f * radius, std::max(0.02f * radius, farScale * centre));
-    cullHierarchy(bvh, f, CullTest::Planes, &counts[0]);
-    cullHierarchy(bvh, f, CullTest::PlanesAndCorners, &counts[1]);
-    drawCullingMap(image, x0, image.width() - x0, bvh, f, test, level, up);
-}
-
-}  // namespace
 
 int main(int argc, char** argv) {
     return runMain("04_bvh", [&] {
@@ -59,14 +43,7 @@ int main(int argc, char** argv) {
         app.add_option("--bins", measure.bins, "binned SAH: bins per axis")
             ->check(CLI::Range(2, 256))
             ->capture_default_str();
-        bool measuring = false;
-        app.add_flag("--measure", measuring,
-                     "also measure builders, traversal, cracks and culling");
-        app.add_option("--measure-rays", measure.traceRays, "rays per kind in the speed table")
-            ->check(CLI::Range(size_t(100), size_t(10000000)));
-        app.add_option("--crack-rays", measure.crackRays,
-                       "rays per mesh and feature for the crack count")
-            ->check(CLI::Range(size_t(1), size_t(10000000)));
+        addMeasureOptions(app, measure);
         EngineCommands commands(app);
         parseCommandLine(app, argc, argv);
         if (std::optional<int> code = commands.run()) return *code;
@@ -85,17 +62,7 @@ int main(int argc, char** argv) {
                                 "scene '" + scene.name + "' through the " +
                                     bvhBuilderName(build.builder) + " hierarchy",
                                 report);
-            if (geometry) {
-                report.facts["build_ms"] = geometry->stats().buildMs;
-                report.facts["nodes"] = geometry->stats().nodes;
-                report.facts["sah_cost"] = geometry->stats().sahCost;
-                addCullingMap(report, geometry->bvh(), out, opts.width, opts.height,
-                              scene.camera.up);
-                measure.seed = opts.seed;
-                measure.dataDir = opts.dataDir;
-                if (measuring)
-                    addMeasurements(report, {scene.name, &scene.mesh}, geometry->bvh(), measure);
-            }
+            if (geometry) addTreeReport(report, scene, *geometry, out, opts, measure);
             writeReport(report, opts);
             return 0;
         }
@@ -105,20 +72,14 @@ int main(int argc, char** argv) {
         Camera start = scene.camera;
         start.aspect = float(settings.width) / float(settings.height);
         OrbitController orbit(start);
-        CullTest test = CullTest::Planes;
-        int level = 6;
-        float farScale = 1.0f;
+        CullingMapWindow map;
         bool dirty = true;
         Image image(opts.width, opts.height);
         double renderMs = 0.0;
-        CullCounts counts[2];
         WindowCallbacks cb;
         cb.keys = {
-            {SDLK_b, "next builder (midpoint / median / binned SAH / spatial splits), rebuilds"},
-            {SDLK_c, "culling test: planes / planes + frustum corners"},
-            {SDLK_l, "show deeper boxes in the map"},
-            {SDLK_k, "show shallower boxes in the map"},
-            {SDLK_f, "far plane: through the target / 3x further"}};
+            {SDLK_b, "next builder (midpoint / median / binned SAH / spatial splits), rebuilds"}};
+        for (const KeyBinding& k : CullingMapWindow::keys()) cb.keys.push_back(k);
         cb.onKey = [&](int key) {
             constexpr BvhBuilder cycle[] = {BvhBuilder::Midpoint, BvhBuilder::Median,
                                             BvhBuilder::BinnedSah, BvhBuilder::SpatialSah};
@@ -127,15 +88,9 @@ int main(int argc, char** argv) {
                 build.builder =
                     at == std::end(cycle) || at + 1 == std::end(cycle) ? cycle[0] : at[1];
                 geometry = meshGeometry(scene, build);
-            } else if (key == SDLK_c) {
-                test = test == CullTest::Planes ? CullTest::PlanesAndCorners : CullTest::Planes;
-            } else if (key == SDLK_l || key == SDLK_k) {
-                level = std::clamp(level + (key == SDLK_l ? 1 : -1), 0, 64);
-            } else if (key == SDLK_f) {
-                farScale = farScale == 1.0f ? 3.0f : 1.0f;
-            } else {
-                return false;
+                return dirty = true;
             }
+            if (!map.onKey(key)) return false;
             return dirty = true;
         };
         orbit.addTo(cb, [&] { dirty = true; });
@@ -147,8 +102,7 @@ int main(int argc, char** argv) {
             for (int y = 0; y < view.height(); ++y)
                 for (int x = 0; x < view.width(); ++x) image.at(x, y) = view.at(x, y);
             if (geometry)
-                drawMap(image, settings.width, geometry->bvh(), orbit.camera(), farScale, test,
-                        level, scene.camera.up, counts);
+                map.draw(image, settings.width, geometry->bvh(), orbit.camera(), scene.camera.up);
             dirty = false;
             return image;
         };
@@ -158,14 +112,7 @@ int main(int argc, char** argv) {
             const BvhBuildStats& s = geometry->stats();
             ImGui::Text("build %.1f ms, %zu nodes, depth %d, SAH cost %.1f", s.buildMs, s.nodes,
                         s.depth, s.sahCost);
-            ImGui::Text("map (right): %s, depth %d",
-                        test == CullTest::Planes ? "planes (p-vertex)" : "planes + frustum corners",
-                        level);
-            ImGui::Text("grey culled, green kept, red wrongly kept; blue: frustum");
-            for (int i = 0; i < 2; ++i)
-                ImGui::Text("%-9s visited %zu culled %zu kept %zu wrongly kept %zu",
-                            i == 0 ? "planes" : "+corners", counts[i].visited, counts[i].culled,
-                            counts[i].kept, counts[i].wronglyKept);
+            for (const std::string& line : map.status()) ImGui::TextUnformatted(line.c_str());
         };
         runWindow(opts.windowOptions("Step 04: bounding volume hierarchies"), cb);
         return 0;

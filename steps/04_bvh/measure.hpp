@@ -1,16 +1,15 @@
 // Step 04's tables (`--measure`): builds, trace speed against brute force, threads, cracks,
-// frustum culling counts and build time against trace speed; and the top-down picture of
-// the culled hierarchy. Part of the program, not of the chapter's library: the tables
-// measure the engine's builders and trees beside the exercises'.
+// frustum culling counts and build time against trace speed. Part of the program, not of
+// the chapter's library: the tables measure the engine's builders and trees beside the
+// exercises'.
 #pragma once
 
 #include <string>
 #include <vector>
 
 #include "04_bvh/advanced/measure.hpp"
-#include "04_bvh/frustum.hpp"
 #include "04_bvh/trace.hpp"
-#include "core/image.hpp"
+#include "core/app.hpp"
 #include "core/report.hpp"
 
 namespace boxes {
@@ -38,6 +37,7 @@ Table measureTradeoff(const Table& traceSpeed);
 // The whole `--measure` run on the scene's mesh and `bvh` (the program's tree), with the
 // crack count on the bunny and sh1 from dataDir, and the trade-off's plot.
 struct MeasureSettings {
+    bool enabled = false;  // --measure
     int bins = 16;
     size_t traceRays = 100000, crackRays = 5000;
     uint64_t seed = 1;
@@ -45,23 +45,13 @@ struct MeasureSettings {
 };
 void addMeasurements(Report& report, const NamedMesh& mesh, const Bvh& bvh,
                      const MeasureSettings& settings);
-
-// The culling camera for view `index` of `count` around the mesh (used by the measure run
-// and the window's starting view): near the surface, far plane at the mesh's centre.
-struct CullingView {
-    Camera camera;
-    float nearDistance, farDistance;
-};
-CullingView cullingView(const Bounds3f& bounds, int index, int count, float aspect);
-
-// Draws the hierarchy's boxes at `level` (leaves above it too) seen from above (along
-// `up`), coloured by the test's verdict, and the frustum's outline.
-void drawCullingMap(Image& image, int x0, int width, const Bvh& bvh, const Frustum& frustum,
-                    CullTest test, int level, Vec3 up);
-
-// The headless run's culling map: the hierarchy from above (depth 6) in the first measuring
-// view, written beside `png` (suffix "-cull") and added to the report.
-void addCullingMap(Report& report, const Bvh& bvh, const std::string& png, int width, int height,
-                   Vec3 up);
+// The headless report's part of the tree: its figures (build_ms, nodes, sah_cost), the
+// culling map beside `png`, and with settings.enabled the tables (seed and data folder
+// from `options`).
+void addTreeReport(Report& report, const Scene& scene, const MeshBvhGeometry& geometry,
+                   const std::string& png, const CommonOptions& options,
+                   const MeasureSettings& settings);
+// --measure, --measure-rays and --crack-rays into `settings`.
+void addMeasureOptions(CLI::App& app, MeasureSettings& settings);
 
 }  // namespace boxes

@@ -151,7 +151,8 @@ def round_ratios(ours, theirs, key):
 
 
 def read_hits(path):
-    data = open(path, "rb").read()
+    with open(path, "rb") as f:
+        data = f.read()
     return [struct.unpack_from("<fI", data, 8 * i) for i in range(len(data) // 8)]
 
 

@@ -44,17 +44,21 @@ CRASH = "std::raise(SIGSEGV);  // a crash"
 def cases_per_exercise():
     """{exercise id: number of TEST_CASEs in its suites} from the reference tests."""
     counts = {}
-    tests = os.path.join(ROOT, "tests")
-    for name in os.listdir(tests):
-        if not name.endswith(".cpp"):
-            continue
-        with open(os.path.join(tests, name), encoding="utf-8") as f:
-            parts = re.split(r'TEST_SUITE\("', f.read())
-        for p in parts[1:]:
-            m = re.match(r"exercise (\d+\.\d+)\"", p)
-            if m:
-                counts[m.group(1)] = counts.get(m.group(1), 0) + len(re.findall(r"\bTEST_CASE\(", p))
+    for base, _, names in os.walk(os.path.join(ROOT, "tests")):
+        for name in names:
+            if name.endswith(".cpp"):
+                counts_in(os.path.join(base, name), counts)
     return counts
+
+
+def counts_in(path, counts):
+    """Adds the TEST_CASEs per exercise suite of one test file to counts."""
+    with open(path, encoding="utf-8") as f:
+        parts = re.split(r'TEST_SUITE\("', f.read())
+    for p in parts[1:]:
+        m = re.match(r"exercise (\d+\.\d+)\"", p)
+        if m:
+            counts[m.group(1)] = counts.get(m.group(1), 0) + len(re.findall(r"\bTEST_CASE\(", p))
 
 
 def insert_into_block(text, ex_id, line, include=None):

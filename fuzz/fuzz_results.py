@@ -1,11 +1,12 @@
 #!/usr/bin/python3
 """Fuzzes the grader's reading of test results (Python, so not libFuzzer: Hypothesis).
 
-usage: fuzz/fuzz_results.py SECONDS [--artifacts DIR]   fuzz for SECONDS (tools/fuzz.sh)
+usage: fuzz/fuzz_results.py SECONDS [--artifacts DIR]   fuzz for SECONDS (fuzz/fuzz.sh)
        fuzz/fuzz_results.py --replay PATH...             every corpus file once (ctest)
 
-The functions: tools/exercises.py case_results (doctest's XML results, from a file as the
-grader and the tour's report read them, and from a string), and tools/grade.py list_cases
+The functions: tools/grading/exercises.py case_results (doctest's XML results, from a file as
+the grader and the tour's report read them, and from a string), and tools/grading/grade.py
+list_cases
 (the XML of --list-test-cases, read from the test program's stdout; its sandbox run is
 replaced by one whose stdout is the input, as raw bytes).
 
@@ -19,7 +20,7 @@ name, bool passed, a one-line message, empty when passed) within 30 s; list_case
 [(suite, name)] or raises RuntimeError (its documented error). A broken promise is saved
 as DIR/crash-SHA1 (a hang as timeout-SHA1) and the exit status is 1; copy it into the
 corpus with the fix. Before each input the input is also written to DIR/current, so a
-crash of the interpreter itself leaves it behind (tools/fuzz.sh keeps it).
+crash of the interpreter itself leaves it behind (fuzz/fuzz.sh keeps it).
 """
 import hashlib
 import os
@@ -30,17 +31,17 @@ import time
 
 HERE = os.path.dirname(os.path.abspath(__file__))
 ROOT = os.path.dirname(HERE)
-sys.path.insert(0, os.path.join(ROOT, "tools"))
-import exercises  # noqa: E402
+sys.path.insert(0, ROOT)  # the tools package, imported from the repository root
+from tools.grading import exercises  # noqa: E402
 
 try:
-    import grade  # noqa: E402
-except Exception as e:  # the grader is another module: fuzz what exists
+    from tools.grading import grade  # noqa: E402
+except Exception as e:  # a starter kit has no grader: fuzz what exists
     grade = None
-    print(f"fuzz_results: tools/grade.py not imported ({e}); list_cases not fuzzed", file=sys.stderr)
+    print(f"fuzz_results: tools/grading/grade.py not imported ({e}); list_cases not fuzzed", file=sys.stderr)
 
 CORPUS = os.path.join(HERE, "corpus", "results")
-TIME_LIMIT = 30.0  # seconds per input: longer is a hang, as in tools/fuzz.sh
+TIME_LIMIT = 30.0  # seconds per input: longer is a hang, as in fuzz/fuzz.sh
 
 
 OPEN_FINDINGS = set()  # known findings owned elsewhere, reported without failing (none open)

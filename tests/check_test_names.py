@@ -3,8 +3,7 @@
 
 doctest_discover_tests makes one ctest test per case and runs it with --test-case=NAME.
 A ';' in a name is CMake's list separator: the case becomes two tests that select no case
-and pass without running anything (found in stop 19: two such cases had never run under
-ctest). A ',' is escaped for doctest but drops the case's label, so `ctest -L SUITE`
+and pass without running anything, so the case itself never runs under ctest. A ',' is escaped for doctest but drops the case's label, so `ctest -L SUITE`
 (the FP-trap run, one exercise's tests) skips it.
 usage: check_test_names.py TESTS_DIR"""
 import glob

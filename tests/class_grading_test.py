@@ -26,13 +26,12 @@ import time
 import zipfile
 
 ROOT = os.path.dirname(os.path.dirname(os.path.abspath(__file__)))
-sys.path.insert(0, os.path.join(ROOT, "tools"))
-from class_bench import check as check_expected, make_class, student_sources  # noqa: E402
-from classroom import CLASSROOM_STEP_TIMEOUT, exercise_command, step_id  # noqa: E402
-from exercises import exercises  # noqa: E402
-from grade_class import grader_has  # noqa: E402
-from gradescope import isolation_works  # noqa: E402
-from kit import CLASSROOM_WORKFLOW, write_kit  # noqa: E402
+sys.path.insert(0, ROOT)  # the tools package, imported from the repository root
+from tools.grading.class_bench import check as check_expected, make_class, student_sources  # noqa: E402
+from tools.grading.classroom import CLASSROOM_STEP_TIMEOUT, exercise_command, step_id  # noqa: E402
+from tools.grading.exercises import exercises, step_sources  # noqa: E402
+from tools.grading.gradescope import isolation_works  # noqa: E402
+from tools.grading.kit import CLASSROOM_WORKFLOW, write_kit  # noqa: E402
 
 failures = []
 TIMEOUT = "10"  # seconds per test case: the looping student costs it once per case
@@ -49,18 +48,22 @@ def first_step():
 
 
 def no_isolation():
-    """Where bubblewrap cannot run (some containers), the tests run without it, on purpose:
-    the grader's flag for that, old (--no-sandbox) or new (--no-isolation)."""
+    """Where bubblewrap cannot run (some containers), the tests run without it, on purpose."""
     if isolation_works():
         return []
     print("note: bubblewrap cannot run here: grading without isolation")
-    return ["--no-isolation" if grader_has("--no-isolation") else "--no-sandbox"]
+    return ["--no-isolation"]
+
+
+def tool(module):
+    """A grading tool as ./workbook runs it: a module of the tools package, from the root."""
+    return [sys.executable, "-m", f"tools.grading.{module}"]
 
 
 def class_cmd(subs, out, work, jobs=2):
-    return [sys.executable, os.path.join(ROOT, "tools", "grade_class.py"), subs, "--out", out,
-            "--work", work, "--jobs", str(jobs), "--steps", first_step(), "--timeout", TIMEOUT] + \
-           (["--no-sandbox"] if no_isolation() else [])
+    return tool("grade_class") + [subs, "--out", out, "--work", work, "--jobs", str(jobs),
+                                  "--steps", first_step(), "--timeout", TIMEOUT] + \
+        (["--no-sandbox"] if no_isolation() else [])
 
 
 def table(out):
@@ -75,7 +78,7 @@ def scenario_class(work):
     subs, out, workers = os.path.join(dest, "submissions"), os.path.join(work, "class-out"), os.path.join(work, "workers")
     shutil.rmtree(out, ignore_errors=True)
     # Run 1: stopped (SIGTERM, as a Ctrl-C) once the first results are in.
-    p = subprocess.Popen(class_cmd(subs, out, workers), stderr=subprocess.PIPE, text=True)
+    p = subprocess.Popen(class_cmd(subs, out, workers), stderr=subprocess.PIPE, text=True, cwd=ROOT)
     stopped = False
     for line in p.stderr:
         sys.stdout.write(line)
@@ -88,7 +91,7 @@ def scenario_class(work):
         kept = len(json.load(f)["results"])
     check(1 <= kept < 6, f"the stopped run kept {kept} results")
     # Run 2: goes on without grading those again.
-    r = subprocess.run(class_cmd(subs, out, workers), capture_output=True, text=True)
+    r = subprocess.run(class_cmd(subs, out, workers), capture_output=True, text=True, cwd=ROOT)
     print(r.stderr)
     check(r.returncode == 0, "the resumed run finishes")
     with open(os.path.join(out, "run.json")) as f:
@@ -117,7 +120,7 @@ def scenario_class(work):
     check("points.png" in page and "most common first failure" in page and "is not implemented yet" in page,
           "index.html: the distribution and the most common failures")
     # Run 3: nothing changed, nothing graded; then one changed submission alone is graded.
-    r = subprocess.run(class_cmd(subs, out, workers), capture_output=True, text=True)
+    r = subprocess.run(class_cmd(subs, out, workers), capture_output=True, text=True, cwd=ROOT)
     run = json.load(open(os.path.join(out, "run.json")))
     check(r.returncode == 0 and run["graded"] == 0 and table(out) == rows, f"an unchanged class keeps its table: {run}")
     changed = os.path.join(subs, "s00-nothing")
@@ -125,7 +128,7 @@ def scenario_class(work):
     for rel, text in student_sources([solved]).items():
         with open(os.path.join(changed, rel), "w", encoding="utf-8") as f:
             f.write(text)
-    r = subprocess.run(class_cmd(subs, out, workers), capture_output=True, text=True)
+    r = subprocess.run(class_cmd(subs, out, workers), capture_output=True, text=True, cwd=ROOT)
     run = json.load(open(os.path.join(out, "run.json")))
     got = {row[0]: row for row in table(out)[1:]}["s00-nothing"]
     points = {e.id: e.points for e in exercises(ROOT)}
@@ -173,14 +176,14 @@ def scenario_gradescope(work):
     step = first_step()
     ids = {e.id: e.points for e in exercises(ROOT) if f"{e.step:02d}" == step}
     bundle = os.path.join(work, "autograder.zip")
-    r = subprocess.run([sys.executable, os.path.join(ROOT, "tools", "gradescope.py"), "bundle", bundle,
-                        "--steps", step, "--timeout", "30"], capture_output=True, text=True)
+    r = subprocess.run(tool("gradescope") + ["bundle", bundle, "--steps", step, "--timeout", "30"],
+                       capture_output=True, text=True, cwd=ROOT)
     check(r.returncode == 0, "the bundle is written")
     root = os.path.join(work, "autograder")
     shutil.rmtree(root, ignore_errors=True)
     with zipfile.ZipFile(bundle) as z:
         names = z.namelist()
-        check({"setup.sh", "run_autograder", "workbook/tools/grade.py", "workbook/tools/deps.sh"} <= set(names),
+        check({"setup.sh", "run_autograder", "workbook/tools/grading/grade.py", "workbook/tools/deps.sh"} <= set(names),
               "the bundle has setup.sh and run_autograder at its root, and the grader")
         for info in z.infolist():  # zipfile does not restore the modes
             z.extract(info, os.path.join(root, "source"))
@@ -192,7 +195,7 @@ def scenario_gradescope(work):
     shutil.copy2(os.path.join(root, "source", "run_autograder"), os.path.join(root, "run_autograder"))
 
     reference = {os.path.relpath(p, ROOT): open(p, encoding="utf-8").read()
-                 for p in student_sources_paths()}
+                 for p in step_sources(ROOT)}
     doc = gradescope_run(work, root, reference)
     check_format(doc, "reference")
     tests = {t["number"]: t for t in doc.get("tests", [])}
@@ -208,11 +211,6 @@ def scenario_gradescope(work):
                                                and "not implemented" in tests[i]["output"] for i in ids),
           "kit: zero on every exercise, the output naming the missing exercise")
     check(doc.get("score") == 0, "kit: score 0")
-
-
-def student_sources_paths():
-    from exercises import step_sources
-    return step_sources(ROOT)
 
 
 def scenario_classroom(work):
@@ -241,10 +239,9 @@ def scenario_classroom(work):
     step = first_step()
     w0 = os.path.join(work, "workers", "w0")
     for tree, label, want in ((kit, "kit", 1), (ROOT, "reference", 0)):
-        r = subprocess.run([sys.executable, os.path.join(ROOT, "tools", "grade.py"), tree, "--work", w0,
-                            "--steps", step, "--timeout", "30", "--junit", os.path.join(work, "classroom.xml")]
-                           + no_isolation(),
-                           capture_output=True, text=True)
+        r = subprocess.run(tool("grade") + [tree, "--work", w0, "--steps", step, "--timeout", "30",
+                                            "--junit", os.path.join(work, "classroom.xml")] + no_isolation(),
+                           capture_output=True, text=True, cwd=ROOT)
         check(r.returncode == 0, f"{label}: graded into the shared grading build")
         # The grader configures its tree without ctest discovery (BOXES_GRADING); the kit's
         # workflow runs ctest in an ordinary build, so turn discovery back on for this step.

@@ -39,10 +39,13 @@ import time
 import xml.etree.ElementTree as ET
 
 ROOT = os.path.dirname(os.path.dirname(os.path.abspath(__file__)))
-sys.path.insert(0, os.path.join(ROOT, "tools"))
-from exercises import BEGIN, END, exercises, step_dirs, step_sources  # noqa: E402
-from kit import strip_solutions, write_kit  # noqa: E402
-from sandbox import isolation_problem  # noqa: E402
+sys.path.insert(0, ROOT)  # the tools package, imported from the repository root
+from tools.grading.exercises import BEGIN, END, exercises, step_sources  # noqa: E402
+from tools.grading.kit import NOT_IN_KIT, strip_solutions, write_kit  # noqa: E402
+from tools.grading.sandbox import isolation_problem  # noqa: E402
+
+# The grader as ./workbook grade runs it: a module of the tools package, from the root.
+GRADE = [sys.executable, "-m", "tools.grading.grade"]
 
 SKIPPED = 77  # ctest's SKIP_RETURN_CODE
 
@@ -91,9 +94,9 @@ def isolation_flags():
 
 
 def grade(student, work, steps, junit):
-    cmd = [sys.executable, os.path.join(ROOT, "tools", "grade.py"), student, "--work", work,
-           "--steps", ",".join(steps), "--junit", junit, "--timeout", "120"] + isolation_flags()
-    r = subprocess.run(cmd, capture_output=True, text=True)
+    cmd = GRADE + [student, "--work", work, "--steps", ",".join(steps), "--junit", junit,
+                   "--timeout", "120"] + isolation_flags()
+    r = subprocess.run(cmd, capture_output=True, text=True, cwd=ROOT)
     print(r.stdout)
     if r.returncode != 0:
         print(r.stderr)
@@ -153,7 +156,8 @@ def scenario_kit(work):
         with open(os.path.join(dest, e.path), encoding="utf-8") as f:
             check(f'throw NotImplemented("{e.id}");' in f.read(), f"exercise {e.id} throws NotImplemented")
     check(not os.path.exists(os.path.join(dest, "build")), "no build output in the kit")
-    check(not os.path.exists(os.path.join(dest, "tools", "grade.py")), "no grading in the kit")
+    check(not any(os.path.exists(os.path.join(dest, rel)) for rel in NOT_IN_KIT) and
+          not os.path.exists(os.path.join(dest, "tools", "grading", "grade.py")), "no grader in the kit")
 
 
 def scenario_reference(work):
@@ -243,10 +247,9 @@ def scenario_hidden(work):
                     '    TEST_CASE("hidden: a test that never ends") {\n'
                     "        for (;;) std::this_thread::sleep_for(std::chrono::milliseconds(10));\n"
                     "    }\n}\n")
-        cmd = [sys.executable, os.path.join(ROOT, "tools", "grade.py"), ROOT, "--work", work,
-               "--steps", first, "--junit", os.path.join(work, "hidden.xml"), "--timeout", "3",
-               "--hidden", hidden] + isolation_flags()
-        r = subprocess.run(cmd, capture_output=True, text=True)
+        cmd = GRADE + [ROOT, "--work", work, "--steps", first, "--junit", os.path.join(work, "hidden.xml"),
+                       "--timeout", "3", "--hidden", hidden] + isolation_flags()
+        r = subprocess.run(cmd, capture_output=True, text=True, cwd=ROOT)
     print(r.stdout, r.stderr)
     check(r.returncode == 0, "grade.py with --hidden exits 0")
     lines = {l.split()[0]: l for l in r.stdout.splitlines() if l[:1].isdigit()}
@@ -359,7 +362,7 @@ def secret_paths(work):
     """What the read scenario tries to read: the reference's solutions and the grader's
     source, and the grading tree's test sources."""
     first = exercises(ROOT)[0]
-    return [os.path.join(ROOT, first.path), os.path.join(ROOT, "tools", "grade.py"),
+    return [os.path.join(ROOT, first.path), os.path.join(ROOT, "tools", "grading", "grade.py"),
             os.path.join(work, "src", "tests", "step01_triangle.cpp")]
 
 
@@ -432,11 +435,10 @@ def scenario_hostile(work, kind):
     started = time.monotonic()
     with tempfile.TemporaryDirectory() as student:
         hostile_tree(student, hostile, hostile_body(kind, token, work, port))
-        cmd = [sys.executable, os.path.join(ROOT, "tools", "grade.py"), student, "--work", work,
-               "--steps", first, "--junit", os.path.join(work, f"hostile-{kind}.xml"),
-               "--json", json_path, "--timeout", "30"] + flags
+        cmd = GRADE + [student, "--work", work, "--steps", first, "--junit",
+                       os.path.join(work, f"hostile-{kind}.xml"), "--json", json_path, "--timeout", "30"] + flags
         before = snapshot(work) if os.path.exists(os.path.join(work, "build", "build.ninja")) else None
-        r = subprocess.run(cmd, capture_output=True, text=True, timeout=600)
+        r = subprocess.run(cmd, capture_output=True, text=True, timeout=600, cwd=ROOT)
     seconds = time.monotonic() - started
     print(r.stdout, r.stderr[-3000:])
     check(r.returncode == 0, f"{kind}: grade.py exits 0 ({seconds:.1f} s)")
@@ -499,15 +501,15 @@ def scenario_no_isolation(work):
     json_path = os.path.join(work, "no-isolation.json")
     if os.path.exists(json_path):
         os.remove(json_path)
-    base = [sys.executable, os.path.join(ROOT, "tools", "grade.py"), ROOT, "--work", work,
-            "--steps", first, "--json", json_path, "--junit", os.path.join(work, "no-isolation.xml")]
-    r = subprocess.run(base, capture_output=True, text=True, env=env)
+    base = GRADE + [ROOT, "--work", work, "--steps", first, "--json", json_path, "--junit",
+                    os.path.join(work, "no-isolation.xml")]
+    r = subprocess.run(base, capture_output=True, text=True, env=env, cwd=ROOT)
     print(r.stdout, r.stderr)
     check(r.returncode != 0, f"refused: exit {r.returncode}")
     check(len(r.stderr.strip().splitlines()) == 1 and "cannot create namespaces" in r.stderr
           and "--no-isolation" in r.stderr, "refused: one plain line naming the problem and the flag")
     check(not os.path.exists(json_path) and "Grade:" not in r.stdout, "refused: nothing graded")
-    r = subprocess.run(base + ["--no-isolation"], capture_output=True, text=True, env=env)
+    r = subprocess.run(base + ["--no-isolation"], capture_output=True, text=True, env=env, cwd=ROOT)
     print(r.stdout, r.stderr)
     ids = [e.id for e in exercises(ROOT) if f"{e.step:02d}" == first]
     check(r.returncode == 0 and f"Grade: {points(ids)} of {points(ids)} points" in r.stdout,

@@ -1,9 +1,9 @@
 #!/usr/bin/env bash
-# Hostile programs through tools/sandbox.sh: each limit reports its reason and nothing
+# Hostile programs through tools/grading/sandbox.sh: each limit reports its reason and nothing
 # outside the sandbox changes. Exit 77 (ctest: skipped) where bubblewrap cannot run.
 set -uo pipefail
 root=$(cd "$(dirname "$0")/.." && pwd)
-sandbox=$root/tools/sandbox.sh
+sandbox=$root/tools/grading/sandbox.sh
 # Not under /tmp: the sandbox gives the command a private, empty /tmp.
 work=$(mktemp -d /var/tmp/boxes-hostile-XXXXXX)
 trap 'rm -rf "$work"' EXIT

@@ -1,9 +1,8 @@
-#!/usr/bin/python3
 """Writes out/index.html from the steps' JSON reports (out/NN_name.json), their images, and
 the tests' XML results (out/test_*.xml, doctest's XML reporter): every step's images,
 its measurement tables and plots (matplotlib), and the status of every exercise.
 
-usage: tools/report.py OUT_DIR
+usage: python3 -m tools.report OUT_DIR   (from the repository root; ./workbook tour runs it)
 """
 import glob
 import html
@@ -16,9 +15,8 @@ import matplotlib
 matplotlib.use("Agg")
 import matplotlib.pyplot as plt  # noqa: E402
 
-ROOT = os.path.dirname(os.path.dirname(os.path.abspath(__file__)))
-sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
-from exercises import exercises as marked_exercises, suite_results  # noqa: E402
+from .grading import ROOT  # noqa: E402
+from .grading.exercises import exercises as marked_exercises, suite_results  # noqa: E402
 
 
 def exercises():

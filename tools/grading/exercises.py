@@ -1,5 +1,5 @@
-"""The exercise markers and doctest's XML results, shared by the tour's report (report.py),
-the starter kit (kit.py) and grading (grade.py).
+"""The exercise markers and doctest's XML results, shared by the tour's report
+(tools/report.py), the starter kit (kit.py) and grading (grade.py).
 
 A marker, as in steps/01_triangle/triangle.cpp:
 

@@ -1,9 +1,8 @@
-#!/usr/bin/python3
 """Runs one untrusted command isolated and limited: the grader's student builds and test
-runs (tools/grade.py imports this module), and tools/sandbox.sh on the command line.
+runs (grade.py imports this module), and tools/grading/sandbox.sh on the command line.
 
-usage: tools/sandbox.py [--time S] [--memory MB] [--output MB] [--processes N] [--dir DIR]
-                        [--no-isolation] -- COMMAND [ARGS...]
+usage: tools/grading/sandbox.sh [--time S] [--memory MB] [--output MB] [--processes N]
+                                [--dir DIR] [--no-isolation] -- COMMAND [ARGS...]
 
 Isolation (bubblewrap): the whole system read-only, DIR (default: a fresh temporary folder)
 the only writable place and the working directory, a private /tmp of at most the output
@@ -34,6 +33,7 @@ import signal
 import subprocess
 import sys
 import tempfile
+import threading
 import time
 from dataclasses import dataclass
 
@@ -67,6 +67,30 @@ class Result:
     @property
     def ok(self):
         return self.status == "ok"
+
+
+class Stopped(Exception):
+    """stop_all() was called: this process runs no more sandboxed commands."""
+
+
+_stop = threading.Event()
+_live = set()  # the Popen of every command running now (the class grader runs them on threads)
+_live_lock = threading.Lock()
+
+
+def stop_all():
+    """Kills every command running under the sandbox in this process and refuses new ones
+    (run raises Stopped): the class grader's Ctrl-C, with graders on several threads."""
+    _stop.set()
+    with _live_lock:
+        running = list(_live)
+    for p in running:
+        if p.returncode is not None:  # reaped already: its number may be another's now
+            continue
+        try:
+            os.killpg(p.pid, signal.SIGKILL)
+        except ProcessLookupError:
+            pass
 
 
 def bwrap_program():
@@ -264,7 +288,9 @@ def run(cmd, limits, writable=(), cwd=None, isolate=True, keep=1 << 20, env=None
     """Runs cmd under the sandbox and limits; returns a Result. `writable`: the folders the
     command may write (cwd, default the first of them, is one of them when isolated);
     `hidden`: folders it must not read (they look empty), `readable`: folders inside those
-    it reads after all."""
+    it reads after all. Raises Stopped after stop_all()."""
+    if _stop.is_set():
+        raise Stopped()
     writable = [os.path.abspath(d) for d in writable]
     hidden = [os.path.abspath(d) for d in hidden]
     readable = [os.path.abspath(d) for d in readable]
@@ -275,10 +301,13 @@ def run(cmd, limits, writable=(), cwd=None, isolate=True, keep=1 << 20, env=None
         full = bwrap_prefix(writable or [cwd], cwd, output_bytes, hidden, readable) + ["--"] + full
     cgroup, nproc = _process_limit(limits)
     try:
-        return _run_limited(full, limits, cwd, isolate, keep, env, output_bytes, cgroup, nproc)
+        result = _run_limited(full, limits, cwd, isolate, keep, env, output_bytes, cgroup, nproc)
     finally:
         if cgroup:
             _remove_cgroup(cgroup)
+    if _stop.is_set():  # killed by stop_all: its result is not the command's
+        raise Stopped()
+    return result
 
 
 def _run_limited(full, limits, cwd, isolate, keep, env, output_bytes, cgroup, nproc):
@@ -289,6 +318,23 @@ def _run_limited(full, limits, cwd, isolate, keep, env, output_bytes, cgroup, np
                              preexec_fn=_set_limits(limits, cgroup, nproc))
     except (OSError, subprocess.SubprocessError) as e:
         return Result("failed", f"failed: cannot start ({e})", 127, b"", str(e).encode(), 0.0)
+    with _live_lock:
+        _live.add(p)
+    if _stop.is_set():  # stop_all ran between Popen and now
+        _kill(p)
+    try:
+        return _collect(p, limits, started, isolate, keep, output_bytes)
+    except BaseException:  # KeyboardInterrupt, say: the command does not outlive its run
+        if p.returncode is None:
+            _kill(p)
+        raise
+    finally:
+        with _live_lock:
+            _live.discard(p)
+
+
+def _collect(p, limits, started, isolate, keep, output_bytes):
+    """Reads the command's output within the limits; kills it at the first one passed."""
     out, err = bytearray(), bytearray()
     printed, stopped = 0, ""
     sel = selectors.DefaultSelector()
@@ -362,7 +408,7 @@ def _classify(code, stopped, isolate, out, err, seconds):
 
 
 def main(argv):
-    p = argparse.ArgumentParser(prog="tools/sandbox.sh", description=__doc__.split("\n\n")[0],
+    p = argparse.ArgumentParser(prog="tools/grading/sandbox.sh", description=__doc__.split("\n\n")[0],
                                 epilog="\n\n".join(__doc__.split("\n\n")[2:]),
                                 formatter_class=argparse.RawDescriptionHelpFormatter)
     p.add_argument("--time", type=float, default=10.0, help="wall-clock seconds (default 10)")

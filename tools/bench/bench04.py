@@ -1,11 +1,13 @@
 #!/usr/bin/python3
 """Step 04 beside Intel Embree: the same rays, back to back, one thread each.
 
-usage: tools/bench04.py [--rays N] [--repeat K] [--rounds R] [--meshes bunny,motorbike,oa_thor]
-                        [--kinds primary,diffuse,random]
+usage: tools/bench/bench04.py [--rays N] [--repeat K] [--rounds R]
+                        [--meshes bunny,motorbike,oa_thor] [--kinds primary,diffuse,random]
                         [--builders midpoint,median,sah,sah4,sah8,sbvh,sbvh4,sbvh8]
                         [--no-extras] [--thread-rays N] [--thread-pairs P] [--quiet-wait S]
-                        [--out out/04_bvh_bench.json] [--data DIR] [--program PATH]
+                        [--out out/04_bvh_bench.json] [--program PATH]
+                        [--data DIR | BOXES_MESHES=DIR] [--peer-dir DIR | BOXES_PEER_BENCH=DIR]
+       (./workbook bench ...)
 
 For every mesh and ray kind (primary, diffuse, random) it writes one ray set with
 peer-bench's make_rays.py, runs peer-bench (Embree 3, one thread) and then our
@@ -14,14 +16,17 @@ binned SAH tree collapsed to 4- or 8-wide nodes, `--width 4` or `--width 8`; "sb
 "sbvh 4-wide" and "sbvh 8-wide": the binned SAH with spatial splits, not an exercise), each run
 --repeat passes (the programs report the median), all of it --rounds times, alternating;
 the ratios are the medians of the rounds' own ratios. Each round first waits (at most
---quiet-wait s) until a short probe runs at 90% of its best speed: some minutes on a shared
-machine run memory-bound code 30-40% slower. It compares the hits ray by ray with Embree's.
+--quiet-wait s) until a short probe runs at 90% of its best speed: on a shared machine some
+minutes run memory-bound code 30-40% slower. It compares the hits ray by ray with Embree's.
 The interior map (oa_thor) gets its primary rays from the inside camera of the meshes
 README. Also: binned SAH on
 2 threads against 1 beside Embree's own two-thread speed-up (larger ray sets, alternating
 pairs), and the full-sweep SAH cost (the quality reference). Prints the
 table builder x ray kind x mesh and writes it as JSON (for the report).
-Needs: libembree-dev, python3-numpy (tools/deps.sh bench), the release build.
+Needs: libembree-dev, python3-numpy (tools/deps.sh bench), the release build, and two things
+the workbook does not ship: peer-bench (the Embree harness: build.sh, make_rays.py;
+--peer-dir or BOXES_PEER_BENCH) and the meshes folder (MESH.obj for every --meshes name;
+--data or BOXES_MESHES).
 """
 import argparse
 import json
@@ -36,8 +41,7 @@ import sys
 import tempfile
 import time
 
-ROOT = os.path.dirname(os.path.dirname(os.path.abspath(__file__)))
-PEER = "/work/shared/tools/peer-bench"
+ROOT = os.path.dirname(os.path.dirname(os.path.dirname(os.path.abspath(__file__))))
 INSIDE = ["--eye", "960,-384,2", "--look", "960,600,2", "--up", "0,0,1", "--fov", "90"]
 
 
@@ -97,8 +101,8 @@ def run_ours(cmd, repeat):
 
 class QuietGate:
     """Waits, before each round, for a minute in which memory-bound code runs at its usual
-    speed. On this shared machine some minutes run memory-bound code 30-40% slower (Embree
-    too, ours more) while the load average shows nothing; a round measured in one spoils its
+    speed. On a shared machine some minutes run memory-bound code 30-40% slower (Embree too,
+    ours more) while the load average shows nothing; a round measured in one spoils its
     ratios. The probe: our 8-wide tree on 100,000 diffuse rays of the bunny (about 0.3 s);
     a round starts once the probe reaches 90% of the best it reached in this run, or after
     --quiet-wait seconds."""
@@ -147,7 +151,8 @@ def round_ratios(ours, theirs, key):
 
 
 def read_hits(path):
-    data = open(path, "rb").read()
+    with open(path, "rb") as f:
+        data = f.read()
     return [struct.unpack_from("<fI", data, 8 * i) for i in range(len(data) // 8)]
 
 
@@ -189,6 +194,23 @@ def measure_threads(a, peer, obj, mesh, kind, work, gate):
     return t
 
 
+def outside_paths(data, peer_dir):
+    """(meshes folder, peer-bench folder) from the flags or, without them, BOXES_MESHES and
+    BOXES_PEER_BENCH; raises SystemExit with one line naming the flag and the variable when
+    one is missing or not a folder."""
+    found = []
+    for value, flag, variable, what in (
+            (data, "--data", "BOXES_MESHES", "the meshes folder (MESH.obj for every --meshes name)"),
+            (peer_dir, "--peer-dir", "BOXES_PEER_BENCH", "peer-bench, the Embree harness (build.sh, make_rays.py)")):
+        value = value or os.environ.get(variable, "")
+        if not value:
+            raise SystemExit(f"bench04: {what} is not given: pass {flag} DIR or set {variable}")
+        if not os.path.isdir(value):
+            raise SystemExit(f"bench04: {flag} / {variable} {value}: no such folder")
+        found.append(value)
+    return tuple(found)
+
+
 def main():
     ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     ap.add_argument("--rays", type=int, default=250000)
@@ -205,17 +227,18 @@ def main():
                     help="rays per set for the two-thread row (primary and diffuse)")
     ap.add_argument("--thread-pairs", type=int, default=5,
                     help="alternating 1-thread/2-thread pairs for the two-thread row")
-    ap.add_argument("--data", default="/work/shared/data/meshes")
+    ap.add_argument("--data", help="the meshes folder (default $BOXES_MESHES)")
     ap.add_argument("--out", default=os.path.join(ROOT, "out", "04_bvh_bench.json"))
     ap.add_argument("--program", default=os.path.join(ROOT, "build/release/steps/04_bvh/04_bvh"))
-    ap.add_argument("--peer-dir", default=PEER)
+    ap.add_argument("--peer-dir", help="peer-bench's folder (default $BOXES_PEER_BENCH)")
     ap.add_argument("--quiet-wait", type=float, default=60,
                     help="seconds a round may wait for a quiet minute (0: no probe, no wait)")
     a = ap.parse_args()
+    a.data, a.peer_dir = outside_paths(a.data, a.peer_dir)
 
     work = tempfile.mkdtemp(prefix="boxes-bench04-")
     peer_src = os.path.join(work, "peer-bench")
-    shutil.copytree(a.peer_dir, peer_src)  # the shared folder is read-only
+    shutil.copytree(a.peer_dir, peer_src)  # built in a copy: its folder may be read-only
     # Embree's own build script uses -march=native: that is Embree's side, ours stays portable.
     subprocess.run(["sh", os.path.join(peer_src, "build.sh")], check=True, capture_output=True)
     peer = os.path.join(peer_src, "peer-bench")
@@ -229,8 +252,8 @@ def main():
             extra = INSIDE if (mesh == "oa_thor" and kind == "primary") else []
             make_rays(peer_src, obj, kind, a.rays, rays, extra)
             # Rounds: Embree, then every builder, again and again; each ratio is the median
-            # of the rounds' own ratios, so a burst of load on this shared machine spoils
-            # one round, not the comparison (a single run drifts by 10-20%).
+            # of the rounds' own ratios, so a burst of load on a shared machine spoils one
+            # round, not the comparison (a single run drifts by 10-20%).
             # (row name, --builders name, trace options); "sah 4-wide", "sah 8-wide": the
             # binned SAH tree collapsed to 4- or 8-wide nodes, SIMD traversal.
             variants = [(b, args) for b, key, args in (
@@ -386,8 +409,8 @@ def main():
         "columns": ["builder"] + ["%s %s" % (m, k) for m, k in sets],
         "rows": [[b] + [ratio_of.get((b, m, k)) for m, k in sets] for b in builders],
         "note": "Per cell the median of the rounds' ratios (%d rounds; the Mrays/s are in "
-                "bench04_embree). Issue 5's targets: binned SAH ('sah') at least 0.6 on "
-                "primary and 0.35 on diffuse rays; the stretch goal a 4-wide tree at 1.0"
+                "bench04_embree). The targets: binned SAH ('sah') at least 0.6 on primary "
+                "and 0.35 on diffuse rays; the stretch goal a 4-wide tree at 1.0"
                 % a.rounds}
     cpu = "unknown CPU"
     try:

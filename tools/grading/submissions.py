@@ -1,6 +1,6 @@
 """Students' submissions as the grader sees them: a folder, a git repository or an archive
 (.zip, .tar, .tar.gz/.tgz, .tar.bz2, .tar.xz) per student, reduced to what the grader reads,
-the C++ sources of the step folders (tools/grade.py student_sources). Shared by the class
+the C++ sources of the step folders (grade.py student_sources). Shared by the class
 grader (grade_class.py) and the Gradescope autograder (gradescope.py).
 
 Unpacking is defensive: an archive member is taken only when it is a regular file under a
@@ -17,7 +17,7 @@ import subprocess
 import tarfile
 import zipfile
 
-from exercises import SOURCE_SUFFIXES
+from .exercises import SOURCE_SUFFIXES
 
 MAX_FILES = 2000  # step sources in one submission
 MAX_BYTES = 20 << 20  # their total size

@@ -1,9 +1,8 @@
-#!/usr/bin/python3
 """Writes a starter kit: a copy of the workbook's tracked files (git ls-files; no build
 output) with every solution block replaced by a stub that throws NotImplemented("N.M").
-Grading (tools/grade.py and its tests) stays out of the kit: it needs the solutions.
+The grader (GRADER below, and its tests) stays out of the kit: it needs the solutions.
 
-usage: tools/kit.py DIR        (./workbook kit DIR)
+usage: ./workbook kit DIR        (python3 -m tools.grading.kit DIR, from the repository root)
 
 Nothing between the markers survives: the kit's file is the reference file with each
 block's lines (from BEGIN SOLUTION to END SOLUTION, both included) replaced by the stub, and
@@ -15,15 +14,17 @@ import shutil
 import subprocess
 import sys
 
-sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
-from exercises import BEGIN, END, SOURCE_SUFFIXES, exercises, parse_file  # noqa: E402
+from . import ROOT
+from .classroom import workflow
+from .exercises import BEGIN, END, SOURCE_SUFFIXES, exercises, parse_file
 
-ROOT = os.path.dirname(os.path.dirname(os.path.abspath(__file__)))
 SKIP_DIRS = {".git", "build", "out", "kit", "node_modules", "__pycache__"}
-# Grading belongs to the instructor's reference tree: it needs the solutions.
-NOT_IN_KIT = {"tools/grade.py", "tests/grading_test.py", "tools/grade_class.py", "tools/class_bench.py",
-              "tools/gradescope.py", "tests/class_grading_test.py"}
-CLASSROOM_WORKFLOW = ".github/workflows/classroom.yml"  # GitHub Classroom (tools/classroom.py)
+# The grader's modules: they belong to the instructor's reference tree (they need the
+# solutions). Their end-to-end tests and unit tests stay out with them.
+GRADER = ("grade", "grade_class", "gradescope", "class_bench")
+NOT_IN_KIT = ({f"tools/grading/{m}.py" for m in GRADER} | {f"tests/tools/test_{m}.py" for m in GRADER}
+              | {"tests/grading_test.py", "tests/class_grading_test.py"})
+CLASSROOM_WORKFLOW = ".github/workflows/classroom.yml"  # GitHub Classroom (classroom.py)
 
 
 def tracked_files(root):
@@ -121,8 +122,6 @@ def write_kit(dest, root=ROOT):
         else:
             shutil.copy2(src, dst)
     # GitHub Classroom's autograding: one step per exercise with its points.
-    from classroom import workflow
-
     os.makedirs(os.path.dirname(os.path.join(dest, CLASSROOM_WORKFLOW)), exist_ok=True)
     with open(os.path.join(dest, CLASSROOM_WORKFLOW), "w", encoding="utf-8") as f:
         f.write(workflow(exercises(root)))

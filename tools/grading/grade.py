@@ -1,10 +1,9 @@
-#!/usr/bin/python3
 """Grades a student's tree against the workbook's reference tests.
 
-usage: tools/grade.py STUDENT_TREE [--hidden DIR] [--junit FILE] [--json FILE] [--timeout S]
-                      [--memory MB] [--output MB] [--build-timeout S] [--build-memory MB]
-                      [--steps 01,02] [--work DIR] [--jobs N] [--no-isolation]
-       (./workbook grade ...)
+usage: ./workbook grade STUDENT_TREE [--hidden DIR] [--junit FILE] [--json FILE] [--timeout S]
+                        [--memory MB] [--output MB] [--build-timeout S] [--build-memory MB]
+                        [--steps 01,02] [--work DIR] [--jobs N] [--no-isolation]
+       (python3 -m tools.grading.grade ..., from the repository root; in-process: grade())
 
 What the student owns: the C++ sources and headers in the step folders (steps/NN_name/*.cpp,
 *.hpp, ...). Everything else comes from this reference tree: core/, tests/, the CMake files,
@@ -20,7 +19,7 @@ test case of an "exercise N.M" suite runs as its own process; an exercise earns 
 (from the reference's markers) when it has test cases and all of them pass.
 
 The student's code is untrusted: the configure, every build (the compilers read the
-student's sources) and every test case run in tools/sandbox.py's sandbox (bubblewrap: the
+student's sources) and every test case run in sandbox.py's sandbox (bubblewrap: the
 system read-only, one writable folder: WORK/build for a build, a fresh folder per test
 case; a private /tmp, no network, no capabilities) with limits on wall-clock and CPU time,
 memory (address space) and output (--timeout, --memory, --output per test case;
@@ -35,6 +34,7 @@ as JSON (exercise, title, step, points, max, status, reason, case, seconds).
 WORK/build is kept between runs, so grading the next tree rebuilds only what changed.
 """
 import argparse
+import dataclasses
 import json
 import os
 import re
@@ -42,19 +42,32 @@ import shutil
 import sys
 import tempfile
 import time
+import traceback
 import xml.etree.ElementTree as ET
 from dataclasses import dataclass
 
-sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
-from exercises import SOURCE_SUFFIXES, case_results, exercises, step_dirs  # noqa: E402
-from kit import strip_solutions, tracked_files  # noqa: E402
-import sandbox  # noqa: E402
-
-ROOT = os.path.dirname(os.path.dirname(os.path.abspath(__file__)))
+from . import ROOT, sandbox
+from .exercises import SOURCE_SUFFIXES, case_results, exercises, step_dirs
+from .kit import strip_solutions, tracked_files
 
 
-def say(text):
-    print(f"[grade] {text}", file=sys.stderr, flush=True)
+class GradeError(Exception):
+    """Grading cannot start or go on: a bad option, a tree that is not a workbook, the
+    grading tree does not configure, no isolation. The message is one line; `code` is the
+    exit status of ./workbook grade."""
+
+    def __init__(self, message, code=1):
+        super().__init__(message)
+        self.code = code
+
+
+class OutOfTime(Exception):
+    """The whole grading of one tree passed its deadline (the class grader's
+    --student-timeout)."""
+
+
+def say(text, log=None):
+    print(f"[grade] {text}", file=log or sys.stderr, flush=True)
 
 
 def read(path):
@@ -84,13 +97,13 @@ def hidden_tests(hidden, step_numbers):
     if not hidden:
         return by_step
     if not os.path.isdir(hidden):
-        raise SystemExit(f"grade: --hidden {hidden}: no such folder")
+        raise GradeError(f"grade: --hidden {hidden}: no such folder")
     for f in sorted(os.listdir(hidden)):
         m = re.match(r"(?:test_)?step(\d\d)", f)
         if not f.endswith(".cpp"):
             continue
         if not m or m.group(1) not in step_numbers:
-            raise SystemExit(f"grade: hidden test {f}: name it stepNN*.cpp for one of the steps "
+            raise GradeError(f"grade: hidden test {f}: name it stepNN*.cpp for one of the steps "
                              f"{', '.join(sorted(step_numbers))}")
         by_step.setdefault(m.group(1), []).append(f)
     return by_step
@@ -142,7 +155,7 @@ def assemble(student, hidden, work, steps):
         files[rel] = text.encode()
     # Hidden tests: compiled into their step's test program.
     by_step = hidden_tests(hidden, {n[:2] for n in step_names})
-    extra = ["", "# Added by tools/grade.py: the instructor's hidden tests."]
+    extra = ["", "# Added by tools/grading/grade.py: the instructor's hidden tests."]
     for number, names in by_step.items():
         if number not in steps:
             continue
@@ -172,6 +185,23 @@ class Isolation:
     # tree, the instructor's hidden tests and home folders. It reads the grading tree instead
     # (a build: WORK/src and WORK/build; a test: WORK/build and the data).
     hidden: tuple = ()
+    deadline: float = None  # time.monotonic() by which the whole grading ends (None: none)
+    log: object = None  # where progress goes (None: stderr)
+
+
+def sandboxed(cmd, limits, iso, **kw):
+    """sandbox.run with the isolation's settings, within its deadline: a run's time limit
+    is cut to the time left, and OutOfTime is raised once none is left."""
+    if iso.deadline is not None:
+        left = iso.deadline - time.monotonic()
+        if left <= 0:
+            raise OutOfTime()
+        if left < limits.seconds:
+            limits = dataclasses.replace(limits, seconds=left)
+    r = sandbox.run(cmd, limits, isolate=iso.isolate, hidden=iso.hidden, **kw)
+    if iso.deadline is not None and time.monotonic() >= iso.deadline:
+        raise OutOfTime()
+    return r
 
 
 def clean_env(home):
@@ -221,15 +251,14 @@ def configure(work, iso):
     if os.path.exists(os.path.join(build, "build.ninja")) and all(
             configured.get(k) == v for k, v in GRADING_CACHE.items()):
         return
-    say("configuring the grading tree (once; later grades reuse it)")
+    say("configuring the grading tree (once; later grades reuse it)", iso.log)
     os.makedirs(build, exist_ok=True)
-    r = sandbox.run(["cmake", "-S", os.path.join(work, "src"), "-B", build, "-G", "Ninja"] +
-                    [f"-D{k}={v}" for k, v in GRADING_CACHE.items()], iso.build, writable=[build],
-                    isolate=iso.isolate, env=clean_env(build), hidden=iso.hidden,
-                    readable=[os.path.join(work, "src")])
+    r = sandboxed(["cmake", "-S", os.path.join(work, "src"), "-B", build, "-G", "Ninja"] +
+                  [f"-D{k}={v}" for k, v in GRADING_CACHE.items()], iso.build, iso, writable=[build],
+                  env=clean_env(build), readable=[os.path.join(work, "src")])
     if not r.ok:
-        sys.stderr.write((r.stdout + r.stderr).decode(errors="replace"))
-        raise SystemExit(f"grade: configuring the grading tree failed ({r.reason}; see above)")
+        (iso.log or sys.stderr).write((r.stdout + r.stderr).decode(errors="replace"))
+        raise GradeError(f"grade: configuring the grading tree failed ({r.reason}; see above)")
 
 
 def first_error(output, src):
@@ -250,9 +279,9 @@ def build_step(work, number, iso):
     The compilers run on the student's sources, so the build is sandboxed: it writes only
     WORK/build, within the build limits."""
     build = os.path.join(work, "build")
-    r = sandbox.run(["cmake", "--build", build, "--target", f"test_step{number}", "--", f"-j{iso.jobs}"],
-                    iso.build, writable=[build], isolate=iso.isolate, env=clean_env(build),
-                    hidden=iso.hidden, readable=[os.path.join(work, "src")])
+    r = sandboxed(["cmake", "--build", build, "--target", f"test_step{number}", "--", f"-j{iso.jobs}"],
+                  iso.build, iso, writable=[build], env=clean_env(build),
+                  readable=[os.path.join(work, "src")])
     if r.ok:
         return ""
     output = (r.stdout + r.stderr).decode(errors="replace")
@@ -271,9 +300,15 @@ def list_cases(binary, iso, folder):
     """[(suite, test case)] of a test program, or raises RuntimeError saying why not."""
     os.makedirs(folder, exist_ok=True)
     limits = iso.test
-    r = sandbox.run([binary, "--list-test-cases", "--reporters=xml"], limits, writable=[folder],
-                    isolate=iso.isolate, env=clean_env(folder), keep=int(limits.output_mb * (1 << 20)),
-                    hidden=iso.hidden, readable=test_readable(binary))
+    r = sandboxed([binary, "--list-test-cases", "--reporters=xml"], limits, iso, writable=[folder],
+                  env=clean_env(folder), keep=int(limits.output_mb * (1 << 20)),
+                  readable=test_readable(binary))
+    return listed_cases(r)
+
+
+def listed_cases(r):
+    """[(suite, test case)] from the sandbox result of --list-test-cases --reporters=xml, or
+    raises RuntimeError(status, reason) when its output is no such list."""
     try:
         root = ET.fromstring(r.stdout.decode(errors="replace"))
     except ET.ParseError as e:
@@ -309,10 +344,18 @@ def run_case(binary, suite, name, iso, folder):
     result = os.path.join(folder, "result.xml")
     cmd = [binary, "--test-suite=" + doctest_filter(suite), "--test-case=" + doctest_filter(name),
            "--reporters=xml", "--no-version", f"--out={result}"]
-    r = sandbox.run(cmd, iso.test, writable=[folder], isolate=iso.isolate, env=clean_env(folder),
-                    keep=1 << 16, hidden=iso.hidden, readable=test_readable(binary))
-    found = [c for c in case_results(result) if c.name == name] if os.path.exists(result) else []
-    shutil.rmtree(folder, ignore_errors=True)
+    try:
+        r = sandboxed(cmd, iso.test, iso, writable=[folder], env=clean_env(folder), keep=1 << 16,
+                      readable=test_readable(binary))
+        found = [c for c in case_results(result) if c.name == name] if os.path.exists(result) else []
+    finally:
+        shutil.rmtree(folder, ignore_errors=True)
+    return case_outcome(name, r, found)
+
+
+def case_outcome(name, r, found):
+    """How one test case ended, from its sandbox result r and the results doctest wrote for
+    it (found: the CaseResults named `name`; [] when it wrote none)."""
     if r.status in ("time limit", "memory limit", "output limit", "crashed"):
         return CaseOutcome(name, r.status, r.reason, r.seconds)
     if found and found[0].passed and r.ok:
@@ -424,39 +467,72 @@ def exercise_row(e, number, build_error, outcomes, seconds):
             "seconds": sum(o.seconds for o in outcomes) if outcomes else seconds}
 
 
-def refuse_without_isolation(args):
+def refuse_without_isolation(opts, log=None):
     """The grader runs student code: without bubblewrap it refuses unless told otherwise."""
-    if args.no_isolation:
-        say("WARNING: student code runs WITHOUT isolation (--no-isolation): only for code you trust")
+    if opts.no_isolation:
+        say("WARNING: student code runs WITHOUT isolation (--no-isolation): only for code you trust", log)
         return
     problem = sandbox.isolation_problem()
     if problem:
-        print(f"grade: {problem}: refusing to run student code without isolation "
-              "(--no-isolation runs it unprotected, only for code you trust)", file=sys.stderr)
-        raise SystemExit(2)
+        raise GradeError(f"grade: {problem}: refusing to run student code without isolation "
+                         "(--no-isolation runs it unprotected, only for code you trust)", 2)
 
 
-def grade(args):
+@dataclass
+class GradeOptions:
+    """What grading one tree takes besides the tree: the command line's options, with its
+    defaults (main() fills it from the command line; the class grader and Gradescope build
+    it themselves)."""
+    hidden: str = None  # folder of hidden doctest files stepNN*.cpp
+    junit: str = None  # the JUnit XML file (None: WORK/grade.xml)
+    json: str = None  # the per-exercise JSON file (None: none)
+    timeout: float = 60.0  # seconds of one test case, wall clock
+    memory: int = 2048  # MB of address space of a test process
+    output: float = 16.0  # MB printed, and of any file a test writes
+    build_timeout: float = 900.0  # seconds of one step's build
+    build_memory: int = 4096  # MB of address space of a compiler or linker process
+    steps: list = None  # e.g. ["01", "03"] (None: every step with exercises)
+    work: str = None  # the grading tree and its build (None: build/grade)
+    jobs: int = 2  # parallel compile jobs
+    no_isolation: bool = False  # without bubblewrap (the limits still hold)
+
+
+@dataclass
+class Graded:
+    """One tree's grade: the table's rows (exercise_row), the notes, the points."""
+    rows: list
+    notes: list
+    earned: int
+    total: int
+    junit: str  # where the JUnit XML went
+
+
+def grade(student, opts, out=None, log=None, deadline=None):
+    """Grades the tree `student` with GradeOptions `opts`: the points table to `out`
+    (default stdout), progress to `log` (default stderr), the JUnit XML (and the JSON) to
+    their files. Raises GradeError when grading cannot start or go on, OutOfTime once
+    time.monotonic() passes `deadline`, sandbox.Stopped after sandbox.stop_all()."""
     started = time.monotonic()
-    student = os.path.abspath(args.student)
-    if not os.path.isdir(os.path.join(student, "steps")):
-        raise SystemExit(f"grade: {args.student} has no steps/ folder: is it a workbook tree?")
-    work = os.path.abspath(args.work or os.path.join(ROOT, "build", "grade"))
+    out = out or sys.stdout
+    student_path = os.path.abspath(student)
+    if not os.path.isdir(os.path.join(student_path, "steps")):
+        raise GradeError(f"grade: {student} has no steps/ folder: is it a workbook tree?")
+    work = os.path.abspath(opts.work or os.path.join(ROOT, "build", "grade"))
     all_ex = exercises(ROOT)
     numbers = sorted({f"{e.step:02d}" for e in all_ex})
-    steps = numbers if not args.steps else [s.zfill(2) for s in args.steps.split(",")]
+    steps = list(opts.steps) if opts.steps else numbers
     unknown = [s for s in steps if s not in numbers]
     if unknown:
-        raise SystemExit(f"grade: --steps {','.join(unknown)}: no such step with exercises "
+        raise GradeError(f"grade: --steps {','.join(unknown)}: no such step with exercises "
                          f"(steps: {','.join(numbers)})")
-    refuse_without_isolation(args)
-    hidden = args.hidden and os.path.abspath(args.hidden)
-    unreadable = (ROOT, student, hidden, os.path.expanduser("~"), "/home", "/root")
-    iso = Isolation(not args.no_isolation,
-                    build=sandbox.Limits(args.build_timeout, args.build_memory, args.output, file_mb=2048),
-                    test=sandbox.Limits(args.timeout, args.memory, args.output), jobs=args.jobs,
-                    hidden=tuple(dict.fromkeys(p for p in unreadable if p)))
-    notes = assemble(student, hidden, work, steps)
+    refuse_without_isolation(opts, log)
+    hidden = opts.hidden and os.path.abspath(opts.hidden)
+    unreadable = (ROOT, student_path, hidden, os.path.expanduser("~"), "/home", "/root")
+    iso = Isolation(not opts.no_isolation,
+                    build=sandbox.Limits(opts.build_timeout, opts.build_memory, opts.output, file_mb=2048),
+                    test=sandbox.Limits(opts.timeout, opts.memory, opts.output), jobs=opts.jobs,
+                    hidden=tuple(dict.fromkeys(p for p in unreadable if p)), deadline=deadline, log=log)
+    notes = assemble(student_path, hidden, work, steps)
     if not iso.isolate:
         notes.append("student code ran without isolation (--no-isolation)")
     configure(work, iso)
@@ -464,7 +540,7 @@ def grade(args):
     with tempfile.TemporaryDirectory(prefix="boxes-grade-") as scratch:
         for number in steps:
             items = [e for e in all_ex if f"{e.step:02d}" == number]
-            say(f"step {number}: building test_step{number}")
+            say(f"step {number}: building test_step{number}", log)
             t0 = time.monotonic()
             error = build_step(work, number, iso)
             outcomes = {e.id: [] for e in items}
@@ -475,7 +551,7 @@ def grade(args):
                              if s.startswith("exercise ")]
                 except RuntimeError as e:
                     error, cases = tuple(e.args), []
-                say(f"step {number}: running {len(cases)} test cases")
+                say(f"step {number}: running {len(cases)} test cases", log)
                 for i, (suite, name) in enumerate(cases):
                     ex = suite.split(" ", 1)[1]
                     if ex not in outcomes:
@@ -483,20 +559,83 @@ def grade(args):
                         outcomes[ex] = []
                     o = run_case(binary, suite, name, iso, os.path.join(scratch, f"{number}-{i}"))
                     if not o.passed:
-                        say(f"step {number}: {name}: {o.reason}")
+                        say(f"step {number}: {name}: {o.reason}", log)
                     outcomes[ex].append(o)
             for e in items:
                 rows.append(exercise_row(e, number, error, outcomes[e.id], time.monotonic() - t0))
-    earned, total = print_table(rows, notes)
-    junit = args.junit or os.path.join(work, "grade.xml")
+    earned, total = print_table(rows, notes, out)
+    junit = opts.junit or os.path.join(work, "grade.xml")
     write_junit(junit, rows, notes, time.monotonic() - started)
-    if args.json:
-        write_json(args.json, rows, notes, time.monotonic() - started)
-    say(f"{earned} of {total} points; JUnit XML: {junit}")
-    return 0
+    if opts.json:
+        write_json(opts.json, rows, notes, time.monotonic() - started)
+    say(f"{earned} of {total} points; JUnit XML: {junit}", log)
+    return Graded(rows, notes, earned, total, junit)
+
+
+def results_by_exercise(rows):
+    """The rows as the class grader and Gradescope keep them, one dict per exercise:
+    exercise, title, step, max, passed, points (earned), status, reason (with the first
+    failing test case in front), details (a line per test case), seconds."""
+    results = []
+    for r in rows:
+        reason = r["reason"]
+        if r["case"] and not r["passed"] and r["case"] not in reason:
+            reason = f"{r['case']}: {reason}"
+        details = "\n".join(r["details"]) or r["message"]
+        results.append({"exercise": r["id"], "title": r["title"], "step": r["step"], "max": r["points"],
+                        "passed": r["passed"], "points": r["points"] if r["passed"] else 0,
+                        "status": r["status"], "reason": reason,
+                        "details": [line for line in details.splitlines() if line.strip()],
+                        "seconds": round(r["seconds"], 2)})
+    return results
+
+
+@dataclass
+class Report:
+    """One tree graded into a folder by grade_into."""
+    code: int  # 0 graded; else the exit status ./workbook grade would have; None: out of time
+    seconds: float
+    results: list  # results_by_exercise (empty unless code is 0)
+    notes: list
+    last_line: str  # the log's last line (why, when code is not 0)
+
+
+def grade_into(folder, tree, opts, limit=None):
+    """Grades `tree` in-process into `folder`, as the class grader and Gradescope keep a
+    grade: points.txt (the table), grade.log (the progress), grade.xml and grade.json. A
+    failure to grade is a Report with its code and the log's last line, not an exception;
+    `limit`: seconds for the whole grading (OutOfTime: code None). sandbox.Stopped passes."""
+    os.makedirs(folder, exist_ok=True)
+    opts = dataclasses.replace(opts, junit=os.path.join(folder, "grade.xml"),
+                               json=os.path.join(folder, "grade.json"))
+    for f in (opts.junit, opts.json):
+        if os.path.exists(f):
+            os.remove(f)
+    started = time.monotonic()
+    deadline = started + limit if limit else None
+    code, graded = 0, None
+    with open(os.path.join(folder, "points.txt"), "w") as out, \
+            open(os.path.join(folder, "grade.log"), "w") as log:
+        try:
+            graded = grade(tree, opts, out, log, deadline)
+        except OutOfTime:
+            code = None
+        except (GradeError, SystemExit) as e:
+            code = e.code if isinstance(e.code, int) else 1
+            if str(e):
+                log.write(f"{e}\n")
+        except Exception:  # a bug of the grader: its trace for the instructor, the class goes on
+            code = 1
+            log.write(traceback.format_exc())
+    with open(os.path.join(folder, "grade.log"), errors="replace") as f:
+        last = (f.read().strip().splitlines() or [""])[-1]
+    if graded is None:
+        return Report(code, time.monotonic() - started, [], [], last)
+    return Report(0, time.monotonic() - started, results_by_exercise(graded.rows), graded.notes, last)
 
 
 def main(argv):
+    defaults = GradeOptions()
     p = argparse.ArgumentParser(prog="./workbook grade", description=__doc__.split("\n\n")[0],
                                 epilog="\n\n".join(__doc__.split("\n\n")[2:]),
                                 formatter_class=argparse.RawDescriptionHelpFormatter)
@@ -504,21 +643,21 @@ def main(argv):
     p.add_argument("--hidden", help="folder of extra doctest files stepNN*.cpp")
     p.add_argument("--junit", help="JUnit XML file to write (default WORK/grade.xml)")
     p.add_argument("--json", help="also write the per-exercise results as JSON to this file")
-    p.add_argument("--timeout", type=float, default=60.0,
-                   help="time limit of one test case in seconds, wall clock (default 60)")
-    p.add_argument("--memory", type=int, default=2048,
-                   help="memory limit of a test process in MB, address space (default 2048)")
-    p.add_argument("--output", type=float, default=16.0,
+    p.add_argument("--timeout", type=float, default=defaults.timeout,
+                   help="time limit of one test case in seconds, wall clock (default %(default)g)")
+    p.add_argument("--memory", type=int, default=defaults.memory,
+                   help="memory limit of a test process in MB, address space (default %(default)d)")
+    p.add_argument("--output", type=float, default=defaults.output,
                    help="output limit in MB: what a test or a build prints, and any file a test "
-                        "writes (default 16)")
-    p.add_argument("--build-timeout", type=float, default=900.0,
-                   help="time limit of one step's build in seconds (default 900; the first "
+                        "writes (default %(default)g)")
+    p.add_argument("--build-timeout", type=float, default=defaults.build_timeout,
+                   help="time limit of one step's build in seconds (default %(default)g; the first "
                         "build compiles the core too)")
-    p.add_argument("--build-memory", type=int, default=4096,
-                   help="memory limit of each compiler or linker process in MB (default 4096)")
+    p.add_argument("--build-memory", type=int, default=defaults.build_memory,
+                   help="memory limit of each compiler or linker process in MB (default %(default)d)")
     p.add_argument("--steps", help="grade only these steps, e.g. 01,03")
     p.add_argument("--work", help="where the grading tree and its build live (default build/grade)")
-    p.add_argument("--jobs", type=int, default=2, help="parallel compile jobs (default 2)")
+    p.add_argument("--jobs", type=int, default=defaults.jobs, help="parallel compile jobs (default %(default)d)")
     p.add_argument("--no-isolation", "--no-sandbox", dest="no_isolation", action="store_true",
                    help="build and run student code WITHOUT bubblewrap (the limits still hold); "
                         "only for code you trust, where bubblewrap cannot run")
@@ -526,7 +665,14 @@ def main(argv):
     for flag in ("timeout", "memory", "output", "build_timeout", "build_memory", "jobs"):
         if getattr(args, flag) <= 0:
             p.error(f"--{flag.replace('_', '-')} must be positive")
-    return grade(args)
+    opts = GradeOptions(**{f.name: getattr(args, f.name) for f in dataclasses.fields(GradeOptions)})
+    opts.steps = [s.zfill(2) for s in args.steps.split(",")] if args.steps else None
+    try:
+        grade(args.student, opts)
+    except GradeError as e:
+        print(e, file=sys.stderr)
+        return e.code
+    return 0
 
 
 if __name__ == "__main__":

@@ -1,7 +1,7 @@
 #!/usr/bin/env bash
 # Fuzzes every target (or the ones named) for SECONDS each, one after the other, with
 # clang's libFuzzer under ASan+UBSan, at the lowest CPU priority.
-# usage: tools/fuzz.sh SECONDS [TARGET...]
+# usage: fuzz/fuzz.sh SECONDS [TARGET...]
 #        (targets: obj flags vec3 scene rays sbvh exam_answer results; results is Python)
 # Seeds come from fuzz/corpus/TARGET/ (committed). New coverage goes to build/fuzz/work/
 # TARGET/ (not committed); every crashing, leaking or hanging input found is copied into
@@ -39,8 +39,8 @@ for t in "${targets[@]}"; do
       mv "$artifacts/current" "$artifacts/crash-$(sha1sum "$artifacts/current" | cut -c1-40)"
     fi
   else
-    # -timeout: an input taking longer than 30 s is a hang (10 s gave false timeouts on
-    # this shared machine: ASan's allocator stalled in madvise under load);
+    # -timeout: an input taking longer than 30 s is a hang (under load, on a shared machine,
+    # ASan's allocator can stall for over 10 s in madvise: false timeouts);
     # -rss_limit_mb: a memory blow-up is a finding, not an out-of-memory kill of the machine.
     ASAN_OPTIONS=detect_leaks=1 UBSAN_OPTIONS=print_stacktrace=1:halt_on_error=1 \
       nice -n 19 "$bin" -max_total_time="$seconds" -timeout=30 -rss_limit_mb=2048 \

@@ -1,24 +1,23 @@
-#!/usr/bin/python3
 """Grades a whole class: a folder with one submission per student (a folder, a git
 repository or a .zip/.tar.* archive), in parallel, with the single-tree grader.
 
-usage: tools/grade_class.py SUBMISSIONS [--out DIR] [--jobs N] [--hidden DIR]
-                            [--steps 01,02] [--timeout S] [--student-timeout S]
-       (./workbook grade-class ...)
+usage: ./workbook grade-class SUBMISSIONS [--out DIR] [--jobs N] [--hidden DIR]
+                              [--steps 01,02] [--timeout S] [--student-timeout S]
+       (python3 -m tools.grading.grade_class ..., from the repository root)
 
-Each submission is reduced to its step sources (tools/submissions.py: safe unpacking, size
-limits) and graded by tools/grade.py. Every worker (--jobs, default the number of cores) has
-its own grading folder (OUT/work/wN), primed once with the reference tree and reused for
-every student it grades, so a student costs the compile of their own step sources and the
-relink, not a build of the whole workbook.
+Each submission is reduced to its step sources (submissions.py: safe unpacking, size
+limits) and graded by grade.py, called in-process on a thread per job. Every worker (--jobs,
+default the number of cores) has its own grading folder (OUT/work/wN), primed once with the
+reference tree and reused for every student it grades, so a student costs the compile of
+their own step sources and the relink, not a build of the whole workbook.
 
 Written into OUT (default build/class-grades/): class.csv (student, points per exercise, total,
-build status, seconds), students/NAME/ (the points table, the JUnit XML, grade.json where the
-grader writes it, result.json), index.html (the distribution of points per exercise as a
-table and a plot, and the most common first failure per exercise) and cache.json. Progress
-goes to stderr. A run can be stopped (Ctrl-C) and started again: a submission whose graded
-sources hash to the same value as before (with the same reference, hidden tests and
-options) keeps its result and is not graded again.
+build status, seconds), students/NAME/ (the points table, the JUnit XML, grade.json,
+grade.log, result.json), index.html (the distribution of points per exercise as a table and
+a plot, and the most common first failure per exercise) and cache.json. Progress goes to
+stderr. A run can be stopped (Ctrl-C) and started again: a submission whose graded sources
+hash to the same value as before (with the same reference, hidden tests and options) keeps
+its result and is not graded again.
 """
 import argparse
 import collections
@@ -29,156 +28,35 @@ import html
 import json
 import os
 import signal
-import subprocess
 import sys
 import threading
 import time
-import xml.etree.ElementTree as ET
 from concurrent.futures import ThreadPoolExecutor, as_completed
 
-sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
-from exercises import exercises  # noqa: E402
-from kit import tracked_files  # noqa: E402
-from submissions import (SubmissionError, content_hash, is_submission, read_submission,  # noqa: E402
-                         stage, student_name)
+from . import ROOT, sandbox
+from .exercises import exercises
+from .grade import GradeOptions, grade_into
+from .kit import tracked_files
+from .submissions import SubmissionError, content_hash, is_submission, read_submission, stage, student_name
 
-ROOT = os.path.dirname(os.path.dirname(os.path.abspath(__file__)))
-GRADE = os.path.join(ROOT, "tools", "grade.py")
 CACHE_VERSION = 1
 # What in tools/ decides a grade (besides the reference's sources, tests and CMake files).
-GRADER_FILES = ("tools/grade.py", "tools/exercises.py", "tools/kit.py", "tools/sandbox", "tools/submissions.py")
+GRADER_FILES = ("tools/grading/grade.py", "tools/grading/exercises.py", "tools/grading/kit.py",
+                "tools/grading/sandbox", "tools/grading/submissions.py")
 
 
 def say(text):
     print(f"[class] {text}", file=sys.stderr, flush=True)
 
 
-# The single-tree grader, as a command --------------------------------------------------------
-
-_grader_help = None
-
-
-def grader_has(option):
-    """Whether tools/grade.py knows an option (--json and --no-isolation came later: without
-    --json its JUnit XML is read)."""
-    global _grader_help
-    if _grader_help is None:
-        r = subprocess.run([sys.executable, GRADE, "--help"], capture_output=True, text=True)
-        _grader_help = r.stdout
-    return option in _grader_help
-
-
-_running = set()  # grade.py processes, killed on Ctrl-C or SIGTERM
-_stopping = threading.Event()  # set then: no new grade.py starts
-_running_lock = threading.Lock()
-
-
 def run_grader(tree, work, report_dir, steps=None, hidden=None, timeout=60.0, jobs=1,
-               no_sandbox=False, limit=None, lock_fd=None):
-    """Runs tools/grade.py on one tree into report_dir (points.txt, grade.xml, grade.json);
-    returns (exit code or None when it ran out of time, seconds)."""
-    os.makedirs(report_dir, exist_ok=True)
-    junit = os.path.join(report_dir, "grade.xml")
-    jsonf = os.path.join(report_dir, "grade.json")
-    for f in (junit, jsonf):
-        if os.path.exists(f):
-            os.remove(f)
-    cmd = [sys.executable, GRADE, tree, "--work", work, "--junit", junit, "--timeout", f"{timeout:g}",
-           "--jobs", str(jobs)]
-    if grader_has("--json"):
-        cmd += ["--json", jsonf]
-    if steps:
-        cmd += ["--steps", ",".join(steps)]
-    if hidden:
-        cmd += ["--hidden", hidden]
-    if no_sandbox:  # the grader's flag for running without bubblewrap, old or new
-        cmd += ["--no-isolation" if grader_has("--no-isolation") else "--no-sandbox"]
-    started = time.monotonic()
-    with open(os.path.join(report_dir, "points.txt"), "w") as out, \
-            open(os.path.join(report_dir, "grade.log"), "w") as err:
-        # Its own session, so a time-out kills the whole tree (ninja, the compiler, tests);
-        # the work folder's lock goes with it, so an orphan still holds the folder.
-        with _running_lock:
-            if _stopping.is_set():
-                return -signal.SIGTERM, 0.0
-            p = subprocess.Popen(cmd, stdout=out, stderr=err, stdin=subprocess.DEVNULL,
-                                 start_new_session=True, pass_fds=(lock_fd,) if lock_fd is not None else ())
-            _running.add(p)
-        try:
-            code = p.wait(timeout=limit)
-        except subprocess.TimeoutExpired:
-            os.killpg(p.pid, signal.SIGKILL)
-            p.wait()
-            code = None
-        finally:
-            with _running_lock:
-                _running.discard(p)
-    return code, time.monotonic() - started
-
-
-def kill_running():
-    _stopping.set()
-    with _running_lock:
-        for p in list(_running):
-            try:
-                os.killpg(p.pid, signal.SIGKILL)
-            except ProcessLookupError:
-                pass
-
-
-def status_of_message(message):
-    """The status of a failed exercise from the JUnit message of the first grader."""
-    if "does not build" in message or "does not compile" in message:
-        return "does not compile"
-    if "timed out" in message:
-        return "time limit"
-    if "crashed" in message:
-        return "crashed"
-    return "failed"
-
-
-def load_results(report_dir, all_ex):
-    """[{exercise, title, step, points, max, passed, status, reason, details}] from the
-    grader's JSON (when it writes one) and JUnit XML; None when neither is there."""
-    rows = {}
-    junit = os.path.join(report_dir, "grade.xml")
-    if os.path.exists(junit):
-        try:
-            root = ET.parse(junit).getroot()
-        except ET.ParseError:
-            root = None
-        for case in root.iter("testcase") if root is not None else []:
-            ex = case.get("classname", "").split()[-1]
-            e = all_ex.get(ex)
-            failure = case.find("failure")
-            message = failure.get("message", "") if failure is not None else ""
-            text = (failure.text if failure is not None else case.findtext("system-out")) or ""
-            rows[ex] = {"exercise": ex, "title": e.title if e else "", "step": f"{int(ex.split('.')[0]):02d}",
-                        "max": e.points if e else 0, "passed": failure is None,
-                        "points": (e.points if e else 0) if failure is None else 0,
-                        "status": "passed" if failure is None else status_of_message(message),
-                        "reason": message, "details": [l for l in text.splitlines() if l.strip()],
-                        "seconds": float(case.get("time", "0") or 0)}
-    jsonf = os.path.join(report_dir, "grade.json")
-    if os.path.exists(jsonf):
-        try:
-            with open(jsonf) as f:
-                doc = json.load(f)
-        except (OSError, ValueError):
-            doc = {}
-        for item in doc.get("exercises", []):
-            ex = item["exercise"]
-            row = rows.setdefault(ex, {"exercise": ex, "details": []})
-            row.update({"title": item.get("title", row.get("title", "")),
-                        "step": item.get("step", f"{int(ex.split('.')[0]):02d}"),
-                        "max": item.get("max", 0), "points": item.get("points", 0),
-                        "passed": item.get("status") == "passed", "status": item.get("status", ""),
-                        "reason": item.get("reason", ""), "seconds": item.get("seconds", 0.0)})
-            if item.get("case") and item.get("status") != "passed" and item["case"] not in row["reason"]:
-                row["reason"] = f"{item['case']}: {row['reason']}"
-    if not rows:
-        return None
-    return sorted(rows.values(), key=lambda r: tuple(int(x) for x in r["exercise"].split(".")))
+               no_sandbox=False, limit=None):
+    """Grades one tree in-process into report_dir (points.txt, grade.log, grade.xml,
+    grade.json) in the grading folder `work`; returns grade.Report (code None: it ran out of
+    `limit` seconds)."""
+    opts = GradeOptions(work=work, timeout=timeout, jobs=jobs, steps=steps, hidden=hidden,
+                        no_isolation=no_sandbox)
+    return grade_into(report_dir, tree, opts, limit)
 
 
 # The class --------------------------------------------------------------------------------
@@ -189,7 +67,7 @@ def config_hash(hidden, steps, timeout):
     grader), the hidden tests and the options."""
     h = hashlib.sha256(f"v{CACHE_VERSION} steps={steps} timeout={timeout:g}\n".encode())
     for rel in sorted(tracked_files(ROOT)):
-        if rel.startswith(("slides/", "out/", ".ci/")) or rel.endswith((".md", "_test.py")):
+        if rel.startswith(("slides/", "out/", ".ci/", "tests/tools/")) or rel.endswith((".md", "_test.py")):
             continue
         if rel.startswith("tools/") and not rel.startswith(GRADER_FILES):
             continue  # the class grader, the kit's extras, the report: not what grades
@@ -205,8 +83,8 @@ def config_hash(hidden, steps, timeout):
 
 
 class Workers:
-    """The grading folders OUT/work/wN, one per worker, each locked while in use (the lock
-    is inherited by grade.py, so even an orphaned grader keeps its folder)."""
+    """The grading folders OUT/work/wN, one per worker, each locked (flock) while this class
+    grader runs, so a second one on the same folders waits."""
 
     def __init__(self, root, count):
         self.root, self.free, self.cv = root, list(range(count)), threading.Condition()
@@ -257,17 +135,20 @@ def prime(workers, count, opts, key):
 
     def one(i):
         report = os.path.join(workers.dir(i), "reference")
-        code, seconds = run_grader(ROOT, workers.dir(i), report,
-                                   opts.steps, opts.hidden, opts.timeout, opts.compile_jobs,
-                                   opts.no_sandbox, None, workers.fds[i])
-        rows = load_results(report, opts.all_ex)
-        results[i] = (code, rows, seconds)
-        if code == 0 and rows and all(r["passed"] for r in rows):
+        r = run_grader(ROOT, workers.dir(i), report, opts.steps, opts.hidden, opts.timeout,
+                       opts.compile_jobs, opts.no_sandbox)
+        rows = r.results if r.code == 0 else None
+        results[i] = (r.code, rows, r.seconds)
+        if r.code == 0 and rows and all(x["passed"] for x in rows):
             with open(os.path.join(workers.dir(i), "primed"), "w") as f:
                 f.write(key + "\n")
 
     with ThreadPoolExecutor(len(todo)) as pool:
-        list(pool.map(one, todo))
+        try:
+            list(pool.map(one, todo))
+        except KeyboardInterrupt:  # the pool's threads stop with their sandboxed commands
+            sandbox.stop_all()
+            raise
     for i, (code, rows, seconds) in results.items():
         if code != 0 or not rows or not all(r["passed"] for r in rows):
             failed = [f"{r['exercise']} ({r['reason']})" for r in rows or [] if not r["passed"]]
@@ -288,21 +169,18 @@ def grade_one(sub, workers, opts):
     i = workers.take()
     try:
         tree = stage(sub["files"], os.path.join(workers.dir(i), "student"))
-        code, seconds = run_grader(tree, workers.dir(i), report, opts.steps,
-                                   opts.hidden, opts.timeout, opts.compile_jobs, opts.no_sandbox,
-                                   opts.student_timeout, workers.fds[i])
+        r = run_grader(tree, workers.dir(i), report, opts.steps, opts.hidden, opts.timeout,
+                       opts.compile_jobs, opts.no_sandbox, opts.student_timeout)
     finally:
         workers.give(i)
-    rows = load_results(report, opts.all_ex) if code == 0 else None
-    result["seconds"] = round(seconds, 2)
-    if code is None:
+    result["seconds"] = round(r.seconds, 2)
+    if r.code is None:
         result.update(status="error", build=f"grading ran out of time ({opts.student_timeout:g} s)", rows=[])
-    elif code != 0 or rows is None:
-        with open(os.path.join(report, "grade.log"), errors="replace") as f:
-            last = (f.read().strip().splitlines() or [""])[-1]
-        result.update(status="error", build=f"the grader failed (exit {code}): {last[:200]}", rows=[])
+    elif r.code != 0:
+        result.update(status="error", build=f"the grader failed (exit {r.code}): {r.last_line[:200]}", rows=[])
     else:
-        broken = sorted({r["step"] for r in rows if r["status"] == "does not compile"})
+        rows = r.results
+        broken = sorted({x["step"] for x in rows if x["status"] == "does not compile"})
         result.update(status="graded", rows=rows,
                       build="ok" if not broken else "step " + ",".join(broken) + " does not compile")
     result["total"] = sum(r["points"] for r in result["rows"])
@@ -489,13 +367,12 @@ def grade_class(opts):
                         f"{left} remaining, ETA {eta / 60:.1f} min: {r['student']} "
                         f"{r.get('total', 0)} points ({r['build']}, {r.get('seconds', 0):.0f} s)")
             except KeyboardInterrupt:
-                _stopping.set()
                 for f in futures:
                     f.cancel()
-                kill_running()
+                sandbox.stop_all()  # the graders' threads end with their sandboxed commands
                 raise
     except KeyboardInterrupt:
-        kill_running()
+        sandbox.stop_all()
         say(f"interrupted: {len(results)} results kept in {cache_path}; run the same command to go on")
         return 130
     finally:

@@ -1,14 +1,14 @@
-#!/usr/bin/python3
 """A generated class for the class grader: its test data and its benchmark.
 
-usage: tools/class_bench.py make DEST [--students N] [--steps 01] [--seed S]
-       tools/class_bench.py check OUT EXPECTED.json
-       tools/class_bench.py bench [--students 30] [--steps 01] [--jobs 1,2] [--out DIR]
-       (./workbook bench-grading ...)
+usage: python3 -m tools.grading.class_bench make DEST [--students N] [--steps 01] [--seed S]
+       python3 -m tools.grading.class_bench check OUT EXPECTED.json
+       python3 -m tools.grading.class_bench bench [--students 30] [--steps 01] [--jobs 1,2]
+                                                  [--out DIR]
+       (./workbook bench-grading ... is the bench; run from the repository root)
 
 make: DEST/submissions/ gets N submissions (N >= 6), copies of the starter kit with
 varying exercises of the graded steps solved (their reference solution blocks kept, the
-others stubs, as tools/kit.py writes them): one with nothing solved, one with everything,
+others stubs, as kit.py writes them): one with nothing solved, one with everything,
 one whose step does not compile, one whose solved exercise loops forever, one whose solved
 exercise crashes (SIGSEGV), the rest random subsets. They come as folders, git
 repositories, .zip (with a top folder) and .tar.gz archives. DEST/expected.json holds the
@@ -33,11 +33,10 @@ import sys
 import tarfile
 import zipfile
 
-sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
-from exercises import exercises, step_sources  # noqa: E402
-from kit import strip_solutions, write_kit  # noqa: E402
+from . import ROOT, grade_class
+from .exercises import exercises, step_sources
+from .kit import strip_solutions, write_kit
 
-ROOT = os.path.dirname(os.path.dirname(os.path.abspath(__file__)))
 LOOP = "for (volatile unsigned spin = 0; spin != 1u; spin = spin + 2u) {}  // never ends"
 CRASH = "std::raise(SIGSEGV);  // a crash"
 
@@ -45,17 +44,21 @@ CRASH = "std::raise(SIGSEGV);  // a crash"
 def cases_per_exercise():
     """{exercise id: number of TEST_CASEs in its suites} from the reference tests."""
     counts = {}
-    tests = os.path.join(ROOT, "tests")
-    for name in os.listdir(tests):
-        if not name.endswith(".cpp"):
-            continue
-        with open(os.path.join(tests, name), encoding="utf-8") as f:
-            parts = re.split(r'TEST_SUITE\("', f.read())
-        for p in parts[1:]:
-            m = re.match(r"exercise (\d+\.\d+)\"", p)
-            if m:
-                counts[m.group(1)] = counts.get(m.group(1), 0) + len(re.findall(r"\bTEST_CASE\(", p))
+    for base, _, names in os.walk(os.path.join(ROOT, "tests")):
+        for name in names:
+            if name.endswith(".cpp"):
+                counts_in(os.path.join(base, name), counts)
     return counts
+
+
+def counts_in(path, counts):
+    """Adds the TEST_CASEs per exercise suite of one test file to counts."""
+    with open(path, encoding="utf-8") as f:
+        parts = re.split(r'TEST_SUITE\("', f.read())
+    for p in parts[1:]:
+        m = re.match(r"exercise (\d+\.\d+)\"", p)
+        if m:
+            counts[m.group(1)] = counts.get(m.group(1), 0) + len(re.findall(r"\bTEST_CASE\(", p))
 
 
 def insert_into_block(text, ex_id, line, include=None):
@@ -187,12 +190,11 @@ def check(out, expected_path):
 
 
 def run_class(subs, out, work, jobs, steps, timeout):
-    cmd = [sys.executable, os.path.join(ROOT, "tools", "grade_class.py"), subs, "--out", out,
-           "--work", work, "--jobs", str(jobs), "--steps", ",".join(steps), "--timeout", f"{timeout:g}",
-           "--no-cache"]
-    r = subprocess.run(cmd)
-    if r.returncode != 0:
-        raise SystemExit(f"class_bench: grade_class exited {r.returncode}")
+    """The class grader, in-process, as ./workbook grade-class runs it."""
+    code = grade_class.main([subs, "--out", out, "--work", work, "--jobs", str(jobs),
+                             "--steps", ",".join(steps), "--timeout", f"{timeout:g}", "--no-cache"])
+    if code != 0:
+        raise SystemExit(f"class_bench: grade_class exited {code}")
     with open(os.path.join(out, "run.json")) as f:
         return json.load(f)
 
@@ -231,7 +233,7 @@ def bench(args):
 
 
 def main(argv):
-    p = argparse.ArgumentParser(prog="tools/class_bench.py", description=__doc__.split("\n\n")[0],
+    p = argparse.ArgumentParser(prog="python3 -m tools.grading.class_bench", description=__doc__.split("\n\n")[0],
                                 epilog="\n\n".join(__doc__.split("\n\n")[1:]),
                                 formatter_class=argparse.RawDescriptionHelpFormatter)
     sub = p.add_subparsers(dest="command", required=True)

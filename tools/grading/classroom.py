@@ -1,30 +1,28 @@
-#!/usr/bin/python3
 """GitHub Classroom: the starter kit's autograding workflow (.github/workflows/classroom.yml).
 
-usage: tools/classroom.py [--steps 01,02]      prints the workflow (tools/kit.py writes it)
-       tools/classroom.py --run N.M [TREE]     runs one exercise's command as the workflow does
+usage: python3 -m tools.grading.classroom [--steps 01,02]    prints the workflow (kit.py writes it)
+       python3 -m tools.grading.classroom --run N.M [TREE]   runs one exercise's command as the
+                                                              workflow does
 
 One grading step per exercise, each with the exercise's points as its max-score, so a
 student gets partial credit per exercise. The steps use GitHub Classroom's actions:
 classroom-resources/autograding-command-grader (a command; its exit status decides) and
 classroom-resources/autograding-grading-reporter (the points to Classroom). The rule is the
-grader's (tools/grade.py): the kit's tests are built once (`cmake --build -k 0`, so a step
+grader's (grade.py): the kit's tests are built once (`cmake --build -k 0`, so a step
 that does not compile costs only its own exercises), then the exercise's command runs every
 test case of its doctest suite "exercise N.M" as its own process with a time limit
 (`ctest -L '^exercise N\\.M$'`, each case a ctest test); the exercise earns its points when
-there is at least one case and all pass. Unlike tools/grade.py, the tests run from the
+there is at least one case and all pass. Unlike grade.py, the tests run from the
 student's own repository, so a student can change them: the instructor's grade of record
-comes from tools/grade.py, grade_class.py or the Gradescope bundle.
+comes from grade.py, grade_class.py or the Gradescope bundle.
 """
-import os
 import subprocess
 import sys
 
-sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
-from exercises import exercises  # noqa: E402
+from . import ROOT
+from .exercises import exercises
 
-ROOT = os.path.dirname(os.path.dirname(os.path.abspath(__file__)))
-CASE_TIMEOUT = 60  # seconds per test case, as tools/grade.py's default
+CASE_TIMEOUT = 60  # seconds per test case, as grade.py's default
 CLASSROOM_STEP_TIMEOUT = 10  # minutes for one exercise's step (the action's unit)
 
 
@@ -47,7 +45,7 @@ def quote(text):
 def workflow(all_ex):
     lines = [
         "# Autograding for GitHub Classroom: one step per exercise, each worth its points.",
-        "# Written by the workbook's tools/classroom.py (see the README's instructor section).",
+        "# Written by the workbook's tools/grading/classroom.py (see docs/instructors.md).",
         "name: Autograding Tests",
         "'on': [push, workflow_dispatch, repository_dispatch]",
         "permissions:",

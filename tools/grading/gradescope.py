@@ -1,11 +1,10 @@
-#!/usr/bin/python3
 """Gradescope: an autograder bundle that grades with the workbook's grader.
 
-usage: tools/gradescope.py bundle OUT.zip [--hidden DIR] [--steps 01,02] [--timeout S]
+usage: ./workbook gradescope OUT.zip [--hidden DIR] [--steps 01,02] [--timeout S]
                            [--hidden-visibility after_published|hidden|after_due_date]
-       (./workbook gradescope OUT.zip ...)
-       tools/gradescope.py prime [--root DIR]     (setup.sh, in the bundle)
-       tools/gradescope.py run [--root DIR]       (run_autograder, in the bundle)
+       (python3 -m tools.grading.gradescope bundle OUT.zip ..., from the repository root)
+       python3 -m tools.grading.gradescope prime [--root DIR]   (setup.sh, in the bundle)
+       python3 -m tools.grading.gradescope run [--root DIR]     (run_autograder, in the bundle)
 
 The bundle (upload it as the assignment's autograder; Gradescope's Ubuntu 24.04 image has
 the C++20 compiler the workbook needs) holds setup.sh, run_autograder, workbook/ (this
@@ -14,7 +13,7 @@ setup.sh installs the Debian/Ubuntu packages with workbook/tools/deps.sh (groups
 grade) and primes the grading build in /autograder/work by grading the reference once, so
 a submission costs only the compile of its step sources. run_autograder grades
 /autograder/submission (the student's upload: the workbook tree, its steps/ folder, or one
-archive of it) with tools/grade.py and writes /autograder/results/results.json: one test per
+archive of it) with grade.py (in-process) and writes /autograder/results/results.json: one test per
 exercise (name, number, score, max_score, status passed/failed, output: every test case and
 the first failure, visibility), the total score and the grader's notes. An exercise with
 hidden test cases is shown with --hidden-visibility (default after_published), and a
@@ -35,20 +34,20 @@ import tempfile
 import time
 import zipfile
 
-sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
-from grade_class import ROOT, load_results, run_grader  # noqa: E402
-from exercises import exercises  # noqa: E402
-from kit import tracked_files  # noqa: E402
-from submissions import ARCHIVE_SUFFIXES, SubmissionError, read_submission, stage  # noqa: E402
+from . import ROOT
+from .exercises import exercises
+from .grade_class import run_grader
+from .kit import tracked_files
+from .submissions import ARCHIVE_SUFFIXES, SubmissionError, read_submission, stage
 
 VISIBILITIES = ("hidden", "after_due_date", "after_published", "visible")  # Gradescope's
 
 SETUP_SH = """#!/usr/bin/env bash
 # Gradescope runs this once, as root, when it builds the autograder image (Ubuntu).
-# Written by the workbook's tools/gradescope.py.
+# Written by the workbook's tools/grading/gradescope.py.
 set -euo pipefail
 source_dir=$(cd "$(dirname "$0")" && pwd)  # /autograder/source
-root=${AUTOGRADER_ROOT:-/autograder}
+root=$(cd "${AUTOGRADER_ROOT:-/autograder}" && pwd)
 export DEBIAN_FRONTEND=noninteractive
 if [[ -z ${BOXES_SKIP_APT:-} ]]; then
   apt-get update
@@ -61,14 +60,16 @@ if ! cmake --version | awk 'NR == 1 { split($3, v, "."); exit !(v[1] > 3 || (v[1
 fi
 # Grade the reference once: the core and the tests are built into the image, so a
 # submission costs only the compile of its own step sources.
-python3 "$source_dir/workbook/tools/gradescope.py" prime --root "$root"
+cd "$source_dir/workbook"
+python3 -m tools.grading.gradescope prime --root "$root"
 """
 
 RUN_AUTOGRADER = """#!/usr/bin/env bash
 # Gradescope runs this for every submission (working directory /autograder); it writes
-# /autograder/results/results.json. Written by the workbook's tools/gradescope.py.
-root=${AUTOGRADER_ROOT:-/autograder}
-exec python3 "$root/source/workbook/tools/gradescope.py" run --root "$root"
+# /autograder/results/results.json. Written by the workbook's tools/grading/gradescope.py.
+root=$(cd "${AUTOGRADER_ROOT:-/autograder}" && pwd)
+cd "$root/source/workbook"
+exec python3 -m tools.grading.gradescope run --root "$root"
 """
 
 
@@ -161,17 +162,17 @@ def isolation_works():
 def prime(args):
     config, hidden, work = layout(args.root)
     report = os.path.join(work, "reference")
-    code, seconds = run_grader(ROOT, work, report, config["steps"], hidden, config["timeout"],
-                               os.cpu_count() or 1, not isolation_works())
-    rows = load_results(report, {e.id: e for e in exercises(ROOT)}) or []
-    missing = [r["exercise"] for r in rows if not r["passed"]]
+    r = run_grader(ROOT, work, report, config["steps"], hidden, config["timeout"],
+                   os.cpu_count() or 1, not isolation_works())
+    rows = r.results
+    missing = [x["exercise"] for x in rows if not x["passed"]]
     with open(os.path.join(report, "points.txt")) as f:
         sys.stdout.write(f.read())
-    if code != 0 or not rows or missing:
+    if r.code != 0 or not rows or missing:
         print(f"[gradescope] the reference does not get full points ({', '.join(missing)}): see "
               f"{report}", file=sys.stderr)
         return 1
-    print(f"[gradescope] grading build primed in {seconds:.0f} s: the reference gets full points",
+    print(f"[gradescope] grading build primed in {r.seconds:.0f} s: the reference gets full points",
           file=sys.stderr)
     return 0
 
@@ -219,7 +220,6 @@ def run(args):
     config, hidden, work = layout(args.root)
     results_dir = os.path.join(args.root, "results")
     os.makedirs(results_dir, exist_ok=True)
-    all_ex = {e.id: e for e in exercises(ROOT)}
 
     def write(doc):
         with open(os.path.join(results_dir, "results.json"), "w") as f:
@@ -237,22 +237,21 @@ def run(args):
         tree = stage(files, os.path.join(tmp, "tree"))
         report = os.path.join(tmp, "report")
         isolated = isolation_works()
-        code, _ = run_grader(tree, work, report, config["steps"], hidden, config["timeout"],
-                             os.cpu_count() or 1, not isolated, limit=args.limit)
-        rows = load_results(report, all_ex) if code == 0 else None
+        graded = run_grader(tree, work, report, config["steps"], hidden, config["timeout"],
+                            os.cpu_count() or 1, not isolated, limit=args.limit)
         with open(os.path.join(report, "points.txt")) as f:
             table = f.read()
         with open(os.path.join(report, "grade.log"), errors="replace") as f:
             log = f.read()
     sys.stdout.write(table)
     sys.stderr.write(log)
-    if rows is None:
+    if graded.code != 0:
         write({"score": 0, "output": "The grader failed (the instructor sees its log): "
-               + ((log.strip().splitlines() or [""])[-1])[:300], "tests": []})
+               + graded.last_line[:300], "tests": []})
         return 0
+    rows = graded.results
     # The students see the notes; which hidden test files there are is not for them.
-    notes = [l[len("note: "):] for l in table.splitlines()
-             if l.startswith("note: ") and not l.startswith("note: hidden tests")]
+    notes = [n for n in graded.notes if not n.startswith("hidden tests")]
     if not isolated:
         notes.append("the tests ran in Gradescope's container without bubblewrap")
     write(results_json(rows, config, notes, time.monotonic() - started))

@@ -1,7 +1,7 @@
 #!/usr/bin/env bash
 # Runs one untrusted command isolated and limited (for the grader: student builds and tests).
-# usage: tools/sandbox.sh [--time SECONDS] [--memory MB] [--output MB] [--dir DIR]
-#                         [--no-isolation] -- COMMAND [ARGS...]
+# usage: tools/grading/sandbox.sh [--time SECONDS] [--memory MB] [--output MB] [--processes N]
+#                                 [--dir DIR] [--no-isolation] -- COMMAND [ARGS...]
 # Isolation (bubblewrap): the whole system read-only, DIR (default: a fresh temporary
 # folder) the only writable place and the working directory, a private /tmp, no network,
 # own PID and user namespace without capabilities, killed with this script. Limits:
@@ -10,5 +10,7 @@
 # output limit). Prints one line "sandbox: RESULT" on stdout: ok | failed: exit N |
 # time limit | memory limit | output limit | crashed: SIGNAME. Exit status: 0 ok, 1 failed,
 # 3 limit or crash, 2 usage or refused (no user namespaces and no --no-isolation).
-# The one implementation is tools/sandbox.py (the grader imports it); this is its wrapper.
+# The one implementation is sandbox.py beside this (the grader imports it); this is its
+# wrapper. sandbox.py imports nothing of the workbook, so it runs as a script from the
+# caller's folder (DIR and the command's paths are the caller's).
 exec /usr/bin/python3 "$(dirname "$0")/sandbox.py" "$@"

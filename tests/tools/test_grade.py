@@ -1,0 +1,254 @@
+"""Unit tests of tools/grading/grade.py: the reasons a case or a build fails, the points
+table and its files, the hidden tests' names, the grading tree's sync, the deadline."""
+import json
+import os
+import sys
+import tempfile
+import time
+import unittest
+import xml.etree.ElementTree as ET
+
+sys.path.insert(0, os.path.dirname(os.path.dirname(os.path.dirname(os.path.abspath(__file__)))))
+from tools.grading import grade, sandbox  # noqa: E402
+from tools.grading.exercises import CaseResult, Exercise  # noqa: E402
+from tools.grading.grade import CaseOutcome, case_outcome, exercise_row  # noqa: E402
+
+
+def result(status="ok", reason=None, stdout=b"", stderr=b"", seconds=0.25, code=0):
+    return sandbox.Result(status, reason or status, code, stdout, stderr, seconds)
+
+
+class CaseOutcomes(unittest.TestCase):
+    def test_passed(self):
+        o = case_outcome("c", result(), [CaseResult("s", "c", True)])
+        self.assertEqual((o.status, o.reason, o.seconds, o.passed), ("passed", "", 0.25, True))
+
+    def test_a_limit_or_a_crash_is_the_reason_whatever_doctest_wrote(self):
+        for status, why in (("time limit", "time limit"), ("crashed", "crashed: SIGSEGV"),
+                            ("memory limit", "memory limit"), ("output limit", "output limit")):
+            o = case_outcome("c", result(status, why), [CaseResult("s", "c", True)])
+            self.assertEqual((o.status, o.reason), (status, why))
+
+    def test_a_failed_check_names_it(self):
+        o = case_outcome("c", result("failed", "failed: exit 1", code=1),
+                         [CaseResult("s", "c", False, "t.cpp:3: CHECK( x == 1 ) is 2 == 1")])
+        self.assertEqual((o.status, o.reason), ("failed", "failed: t.cpp:3: CHECK( x == 1 ) is 2 == 1"))
+        o = case_outcome("c", result("failed", "failed: exit 1"), [CaseResult("s", "c", False, "")])
+        self.assertEqual(o.reason, "failed: the test case failed")
+
+    def test_bad_alloc_caught_by_doctest_is_the_memory_limit(self):
+        o = case_outcome("c", result("failed", "failed: exit 1"),
+                         [CaseResult("s", "c", False, "threw: std::bad_alloc")])
+        self.assertEqual((o.status, o.reason), ("memory limit", "memory limit"))
+
+    def test_passed_then_failed_at_exit(self):
+        o = case_outcome("c", result("failed", "failed: exit 7", code=7), [CaseResult("s", "c", True)])
+        self.assertEqual((o.status, o.reason), ("failed", "failed: the test passed, then the program ended with failed: exit 7"))
+
+    def test_no_result_written(self):
+        o = case_outcome("c", result(stderr=b"first\nlast words\n"), [])
+        self.assertEqual(o.reason, "failed: no test result (it ended before doctest wrote one): last words")
+        o = case_outcome("c", result("failed", "failed: exit 3", code=3), [])
+        self.assertEqual(o.reason, "failed: no test result, exit 3")
+
+
+class ListedCases(unittest.TestCase):
+    def test_the_list(self):
+        xml = (b'<doctest><TestSuite><TestCase name="a" testsuite="exercise 1.1"/>'
+               b'<TestCase name="b, c" testsuite="core"/></TestSuite></doctest>')
+        self.assertEqual(grade.listed_cases(result(stdout=xml)), [("exercise 1.1", "a"), ("core", "b, c")])
+
+    def test_no_list_says_why(self):
+        with self.assertRaises(RuntimeError) as e:
+            grade.listed_cases(result("time limit", stdout=b"spinning"))
+        self.assertEqual(e.exception.args, ("time limit", "time limit (the test program does not list its tests)"))
+        with self.assertRaises(RuntimeError) as e:
+            grade.listed_cases(result("failed", "failed: exit 2", stdout=b"\xff\xfe not xml"))
+        self.assertEqual(e.exception.args, ("failed", "failed: failed: exit 2 (the test program does not list its tests)"))
+
+    def test_doctest_filters_escape_commas(self):
+        self.assertEqual(grade.doctest_filter("a, b,c"), "a\\, b\\,c")
+
+
+SRC = "/work/grade/src"
+
+
+class BuildReasons(unittest.TestCase):
+    def test_the_compilers_first_error(self):
+        log = (f"[1/3] g++ -c {SRC}/steps/01_x/x.cpp\n"
+               f"{SRC}/steps/01_x/x.cpp:12:5: warning: unused variable\n"
+               f"{SRC}/steps/01_x/x.cpp:40:1: error: expected ';' before '}}' token\n"
+               f"{SRC}/steps/01_x/x.cpp:41:1: error: a second one\n")
+        self.assertEqual(grade.first_error(log, SRC), "steps/01_x/x.cpp:40:1: error: expected ';' before '}' token")
+
+    def test_the_linkers_error_then_ninjas_line(self):
+        self.assertEqual(grade.first_error("x.o: undefined reference to `f()'\n", SRC), "x.o: undefined reference to `f()'")
+        self.assertEqual(grade.first_error("FAILED: tests/test_step01\n", SRC), "FAILED: tests/test_step01")
+        self.assertEqual(grade.first_error("nothing useful\n", SRC), "the build failed")
+
+    def test_a_limit_names_the_source_being_compiled(self):
+        log = f"[2/9] g++ -O1 -c {SRC}/steps/01_x/a.cpp -o a.o\n[3/9] g++ -c {SRC}/steps/01_x/b.cpp -o b.o\n"
+        self.assertEqual(grade.build_reason(result("memory limit"), log, SRC),
+                         "does not compile: memory limit (compiling steps/01_x/b.cpp)")
+        self.assertEqual(grade.build_reason(result("time limit", seconds=901.4), log, SRC),
+                         "does not compile: time limit (compiling steps/01_x/b.cpp) (the build ran over 901 s)")
+        self.assertEqual(grade.build_reason(result("failed", "failed: exit 1"), f"{SRC}/x.cpp:1: error: no\n", SRC),
+                         "does not compile: x.cpp:1: error: no")
+
+
+EXERCISES = [Exercise("1.1", "a sum", 1, "steps/01_x/x.cpp"), Exercise("1.2", "a root", 2, "steps/01_x/x.cpp"),
+             Exercise("1.3", "a box", 3, "steps/01_x/x.cpp"), Exercise("2.1", "a tree", 4, "steps/02_y/y.cpp")]
+
+
+def table_rows():
+    ok, bad = CaseOutcome("fine", "passed", "", 0.5), CaseOutcome("edge", "failed", "failed: CHECK( x )", 0.25)
+    return [exercise_row(EXERCISES[0], "01", "", [ok, ok], 9.0),
+            exercise_row(EXERCISES[1], "01", "", [ok, bad], 9.0),
+            exercise_row(EXERCISES[2], "01", "", [], 9.0),
+            exercise_row(EXERCISES[3], "02", "does not compile: y.cpp:1: error: no", [], 3.0)]
+
+
+class PointsTable(unittest.TestCase):
+    def test_rows(self):
+        rows = table_rows()
+        self.assertEqual([(r["id"], r["passed"], r["status"]) for r in rows],
+                         [("1.1", True, "passed"), ("1.2", False, "failed"), ("1.3", False, "no tests"),
+                          ("2.1", False, "does not compile")])
+        self.assertEqual(rows[1]["message"], 'failed: CHECK( x ) (test case "edge")')
+        self.assertEqual(rows[1]["details"], ["passed: fine", "FAILED: edge: failed: CHECK( x )"])
+        self.assertEqual((rows[0]["seconds"], rows[3]["seconds"]), (1.0, 3.0))  # cases' time, else the step's
+        self.assertEqual(rows[2]["reason"], "no test cases for this exercise")
+        start = exercise_row(EXERCISES[0], "01", ("time limit", "time limit (the test program does not list its tests)"), [], 1.0)
+        self.assertEqual((start["status"], start["case"]), ("time limit", ""))
+        long = exercise_row(EXERCISES[0], "01", "does not compile: " + "x" * 600, [], 1.0)
+        self.assertEqual((len(long["reason"]), long["reason"][-3:]), (500, "..."))
+
+    def test_the_printed_table(self):
+        with tempfile.TemporaryFile("w+") as out:
+            self.assertEqual(grade.print_table(table_rows(), ["a note"], out), (1, 10))
+            out.seek(0)
+            text = out.read()
+        self.assertEqual(text.split("\n"), [
+            "", "Grade: 1 of 10 points", "",
+            "exercise  points  result  why it failed",
+            "1.1        1 / 1   passed  ",
+            '1.2        0 / 2   FAILED  failed: CHECK( x ) (test case "edge")',
+            "1.3        0 / 3   FAILED  no test cases for this exercise",
+            "2.1        0 / 4   FAILED  does not compile: y.cpp:1: error: no",
+            "note: a note", ""])
+
+    def test_json_and_junit_files(self):
+        folder = tempfile.mkdtemp()
+        rows = table_rows()
+        grade.write_json(os.path.join(folder, "g.json"), rows, ["n"], 12.345)
+        with open(os.path.join(folder, "g.json")) as f:
+            doc = json.load(f)
+        self.assertEqual((doc["points"], doc["max"], doc["seconds"], doc["notes"]), (1, 10, 12.35, ["n"]))
+        self.assertEqual(doc["exercises"][1], {"exercise": "1.2", "title": "a root", "step": "01", "points": 0,
+                                               "max": 2, "status": "failed", "reason": "failed: CHECK( x )",
+                                               "case": "edge", "seconds": 0.75})
+        grade.write_junit(os.path.join(folder, "g.xml"), rows, ["n"], 12.3)
+        root = ET.parse(os.path.join(folder, "g.xml")).getroot()
+        self.assertEqual((root.get("tests"), root.get("failures")), ("4", "3"))
+        step1 = root.find("testsuite[@name='step 01']")
+        self.assertEqual({p.get("name"): p.get("value") for p in step1.iter("property")},
+                         {"points": "1", "points_possible": "6"})
+        names = [c.get("name") for c in root.iter("testcase")]
+        self.assertEqual(names[0], "exercise 1.1: a sum (1 point)")
+        self.assertEqual(names[1], "exercise 1.2: a root (2 points)")
+        failure = root.find(".//testcase[@classname='exercise 1.2']/failure")
+        self.assertEqual(failure.get("message"), 'failed: CHECK( x ) (test case "edge")')
+
+    def test_results_by_exercise(self):
+        got = grade.results_by_exercise(table_rows())
+        self.assertEqual(got[0], {"exercise": "1.1", "title": "a sum", "step": "01", "max": 1, "passed": True,
+                                  "points": 1, "status": "passed", "reason": "", "seconds": 1.0,
+                                  "details": ["passed: fine", "passed: fine"]})
+        self.assertEqual((got[1]["points"], got[1]["reason"]), (0, "edge: failed: CHECK( x )"))
+        self.assertEqual(got[3]["details"], ["does not compile: y.cpp:1: error: no"])
+
+
+class GradingTree(unittest.TestCase):
+    def test_hidden_test_names(self):
+        hidden = tempfile.mkdtemp()
+        for name in ("step01_extra.cpp", "test_step02.cpp", "notes.txt"):
+            open(os.path.join(hidden, name), "w").close()
+        self.assertEqual(grade.hidden_tests(hidden, {"01", "02"}),
+                         {"01": ["step01_extra.cpp"], "02": ["test_step02.cpp"]})
+        self.assertEqual(grade.hidden_tests(None, {"01"}), {})
+        open(os.path.join(hidden, "step07.cpp"), "w").close()
+        with self.assertRaisesRegex(grade.GradeError, "hidden test step07.cpp: name it stepNN"):
+            grade.hidden_tests(hidden, {"01", "02"})
+        with self.assertRaisesRegex(grade.GradeError, "no such folder"):
+            grade.hidden_tests(os.path.join(hidden, "missing"), {"01"})
+
+    def test_sync_keeps_unchanged_files_and_removes_others(self):
+        dest = tempfile.mkdtemp()
+        grade.sync_tree(dest, {"a/x.cpp": b"1", "a/y.cpp": b"2", "b/z.cpp": b"3"})
+        old = os.path.join(dest, "a", "x.cpp")
+        os.utime(old, (1, 1))
+        grade.sync_tree(dest, {"a/x.cpp": b"1", "a/y.cpp": b"changed"})
+        self.assertEqual(os.stat(old).st_mtime, 1)  # unchanged: not written, so not rebuilt
+        with open(os.path.join(dest, "a", "y.cpp"), "rb") as f:
+            self.assertEqual(f.read(), b"changed")
+        self.assertFalse(os.path.exists(os.path.join(dest, "b")))
+
+    def test_student_code_sees_no_secrets(self):
+        os.environ["BOXES_SECRET_TOKEN"] = "x"
+        env = grade.clean_env("/box")
+        self.assertNotIn("BOXES_SECRET_TOKEN", env)
+        self.assertEqual((env["HOME"], env["TMPDIR"], env["MALLOC_ARENA_MAX"]), ("/box", "/tmp", "2"))
+        self.assertLessEqual(set(env), {"PATH", "LANG", "LC_ALL", "CC", "CXX", "TZ", "HOME", "TMPDIR", "MALLOC_ARENA_MAX"})
+
+
+class Deadline(unittest.TestCase):
+    def setUp(self):
+        self.real = sandbox.run
+        self.calls = []
+
+        def fake(cmd, limits, **kw):
+            self.calls.append(limits.seconds)
+            return result()
+        sandbox.run = fake
+
+    def tearDown(self):
+        sandbox.run = self.real
+
+    def test_a_run_gets_the_time_left(self):
+        iso = grade.Isolation(False, sandbox.Limits(900), sandbox.Limits(60), deadline=time.monotonic() + 30)
+        grade.sandboxed(["x"], iso.test, iso)
+        self.assertTrue(29 < self.calls[0] <= 30, self.calls)
+        grade.sandboxed(["x"], sandbox.Limits(5), iso)
+        self.assertEqual(self.calls[1], 5)
+
+    def test_no_time_left(self):
+        iso = grade.Isolation(False, sandbox.Limits(900), sandbox.Limits(60), deadline=time.monotonic() - 1)
+        with self.assertRaises(grade.OutOfTime):
+            grade.sandboxed(["x"], iso.test, iso)
+        self.assertEqual(self.calls, [])
+
+    def test_no_deadline(self):
+        iso = grade.Isolation(False, sandbox.Limits(900), sandbox.Limits(60))
+        grade.sandboxed(["x"], iso.test, iso)
+        self.assertEqual(self.calls, [60])
+
+
+class GradeInto(unittest.TestCase):
+    def test_a_tree_that_cannot_be_graded_is_a_report(self):
+        folder = tempfile.mkdtemp()
+        r = grade.grade_into(folder, tempfile.mkdtemp(), grade.GradeOptions(no_isolation=True))
+        self.assertEqual((r.code, r.results), (1, []))
+        self.assertTrue(r.last_line.startswith("grade: ") and r.last_line.endswith("has no steps/ folder: is it a workbook tree?"),
+                        r.last_line)
+        self.assertEqual(sorted(os.listdir(folder)), ["grade.log", "points.txt"])
+
+    def test_an_unknown_step(self):
+        tree = tempfile.mkdtemp()
+        os.makedirs(os.path.join(tree, "steps"))
+        r = grade.grade_into(tempfile.mkdtemp(), tree, grade.GradeOptions(steps=["99"], no_isolation=True))
+        self.assertEqual(r.code, 1)
+        self.assertIn("grade: --steps 99: no such step with exercises", r.last_line)
+
+
+if __name__ == "__main__":
+    unittest.main()

@@ -1,0 +1,45 @@
+"""Unit tests of tools/grading/gradescope.py: results.json in Gradescope's format and the
+hidden tests' names."""
+import os
+import sys
+import tempfile
+import unittest
+
+sys.path.insert(0, os.path.dirname(os.path.dirname(os.path.dirname(os.path.abspath(__file__)))))
+from tools.grading import gradescope  # noqa: E402
+
+ROWS = [{"exercise": "1.1", "title": "a sum", "max": 1, "points": 1, "passed": True, "status": "passed",
+         "reason": "", "details": ["passed: fine", "passed: hidden: one more"]},
+        {"exercise": "1.2", "title": "a root", "max": 2, "points": 0, "passed": False, "status": "time limit",
+         "reason": "slow: time limit", "details": ["FAILED: slow: time limit"]}]
+CONFIG = {"steps": ["01"], "hidden_visibility": "after_due_date", "hidden_cases": {"1.1": ["hidden: one more"]}}
+
+
+class ResultsJson(unittest.TestCase):
+    def test_one_test_per_exercise_and_a_public_one_beside_hidden_tests(self):
+        doc = gradescope.results_json(ROWS, CONFIG, ["a note"], 41.6)
+        self.assertEqual((doc["score"], doc["execution_time"], doc["stdout_visibility"]), (1, 42, "hidden"))
+        self.assertTrue(doc["output"].startswith("1 of 3 points (steps 01);"))
+        self.assertTrue(doc["output"].endswith("note: a note\n"))
+        tests = doc["tests"]
+        self.assertEqual([(t["number"], t["score"], t["max_score"], t["status"], t["visibility"]) for t in tests],
+                         [("1.1", 1, 1, "passed", "after_due_date"), ("1.1.0", 0, 0, "passed", "visible"),
+                          ("1.2", 0, 2, "failed", "visible")])
+        self.assertEqual(tests[1]["output"], "passed: fine")  # the hidden case is not shown
+        self.assertEqual(tests[2]["output"].split("\n"),
+                         ["0 of 2 points: time limit", "first failure: slow: time limit", "FAILED: slow: time limit"])
+        self.assertEqual(tests[0]["name"], "exercise 1.1: a sum")
+
+    def test_hidden_case_names_per_exercise(self):
+        hidden = tempfile.mkdtemp()
+        with open(os.path.join(hidden, "step01_h.cpp"), "w") as f:
+            f.write('TEST_SUITE("exercise 1.1") {\n TEST_CASE("one") {}\n TEST_CASE("two") {}\n}\n'
+                    'TEST_SUITE("core") { TEST_CASE("not counted") {} }\n'
+                    'TEST_SUITE("exercise 1.3") { TEST_CASE("three") {} }\n')
+        with open(os.path.join(hidden, "notes.txt"), "w") as f:
+            f.write('TEST_SUITE("exercise 9.9") { TEST_CASE("no") {} }')
+        self.assertEqual(gradescope.hidden_case_names(hidden), {"1.1": ["one", "two"], "1.3": ["three"]})
+
+
+if __name__ == "__main__":
+    unittest.main()

@@ -1,0 +1,131 @@
+"""Unit tests of tools/grading/kit.py: stripping the solutions from a source."""
+import os
+import sys
+import tempfile
+import unittest
+
+sys.path.insert(0, os.path.dirname(os.path.dirname(os.path.dirname(os.path.abspath(__file__)))))
+from tools.grading import kit  # noqa: E402
+from tools.grading.kit import check_no_solution_left, strip_solutions  # noqa: E402
+
+SOURCE = """#include "steps/01_x/x.hpp"
+#include <cmath>
+
+// EXERCISE 1.1: a sum (1 point)
+float sum(float a, float b) {
+    // BEGIN SOLUTION
+    float secret = a + b;
+    return secret;
+    // END SOLUTION
+}
+
+// EXERCISE 1.2: a square root (2 points)
+float root(float x) {
+    // BEGIN SOLUTION
+    return std::sqrt(x);
+    // END SOLUTION
+}
+"""
+
+
+def source_file(text):
+    root = tempfile.mkdtemp()
+    path = os.path.join(root, "x.cpp")
+    with open(path, "w") as f:
+        f.write(text)
+    return path, root
+
+
+class StripSolutions(unittest.TestCase):
+    def test_every_block_becomes_a_stub(self):
+        path, root = source_file(SOURCE)
+        new, found = strip_solutions(SOURCE, path, root)
+        self.assertEqual([e.id for e in found], ["1.1", "1.2"])
+        self.assertEqual(new.split("\n")[:13], [
+            '#include "steps/01_x/x.hpp"',
+            '#include "core/exercise.hpp"',  # for NotImplemented, after the first include
+            "#include <cmath>",
+            "",
+            "// EXERCISE 1.1: a sum (1 point)",
+            "float sum(float a, float b) {",
+            "    // TODO: your solution (see the step's README)",
+            "    (void)a; (void)b;",
+            '    throw NotImplemented("1.1");',
+            "}",
+            "",
+            "// EXERCISE 1.2: a square root (2 points)",
+            "float root(float x) {"])
+        self.assertNotIn("secret", new)
+        self.assertNotIn("std::sqrt", new)
+        self.assertIn('throw NotImplemented("1.2");', new)
+        self.assertEqual(check_no_solution_left(SOURCE, new), [])
+
+    def test_kept_exercises_keep_their_solution(self):
+        path, root = source_file(SOURCE)
+        new, found = strip_solutions(SOURCE, path, root, keep={"1.2"})
+        self.assertEqual([e.id for e in found], ["1.1"])
+        self.assertIn("return std::sqrt(x);", new)
+        self.assertNotIn("secret", new)
+
+    def test_the_include_is_not_added_twice(self):
+        text = SOURCE.replace("#include <cmath>", '#include "core/exercise.hpp"')
+        path, root = source_file(text)
+        new, _ = strip_solutions(text, path, root)
+        self.assertEqual(new.count('#include "core/exercise.hpp"'), 1)
+
+    def test_a_file_without_exercises_is_unchanged(self):
+        text = "int f() { return 1; }\n"
+        path, root = source_file(text)
+        self.assertEqual(strip_solutions(text, path, root), (text, []))
+
+    def test_an_incomplete_block_is_refused(self):
+        text = SOURCE.replace("    // END SOLUTION\n}\n\n// EXERCISE 1.2", "}\n\n// EXERCISE 1.2", 1)
+        path, root = source_file(text)
+        with self.assertRaises(SystemExit) as e:
+            strip_solutions(text, path, root)
+        self.assertIn("exercise 1.1 has no complete BEGIN SOLUTION ... END SOLUTION block", str(e.exception))
+
+
+class CheckNoSolutionLeft(unittest.TestCase):
+    def test_a_surviving_solution_line_is_found(self):
+        kit_text = SOURCE.replace("    // BEGIN SOLUTION\n", "").replace("    // END SOLUTION\n", "")
+        self.assertIn("float secret = a + b;", check_no_solution_left(SOURCE, kit_text))
+
+    def test_a_line_also_outside_the_blocks_may_stay(self):
+        reference = SOURCE.replace("float root(float x) {", "float root(float x) {\n    return secret;")
+        kit_text = "float root(float x) {\n    return secret;\n}"
+        self.assertEqual(check_no_solution_left(reference, kit_text), [])
+
+    def test_a_marker_left_is_found(self):
+        self.assertEqual(check_no_solution_left("", "    // BEGIN SOLUTION"), ["a BEGIN/END SOLUTION marker"])
+
+
+class KitContents(unittest.TestCase):
+    def test_the_grader_stays_out_and_the_kits_tools_stay_in(self):
+        for module in ("grade", "grade_class", "gradescope", "class_bench"):
+            self.assertIn(f"tools/grading/{module}.py", kit.NOT_IN_KIT)
+        for module in ("kit", "exercises", "classroom", "sandbox", "submissions", "__init__"):
+            self.assertNotIn(f"tools/grading/{module}.py", kit.NOT_IN_KIT)
+        self.assertIn("tests/grading_test.py", kit.NOT_IN_KIT)
+
+    def test_tracked_files_outside_git_skip_build_output(self):
+        root = tempfile.mkdtemp()
+        for rel in ("a.txt", "steps/01_x/x.cpp", "build/release/x.o", "out/index.html",
+                    "slides/node_modules/m.js", "tools/__pycache__/x.pyc"):
+            os.makedirs(os.path.dirname(os.path.join(root, rel)) or root, exist_ok=True)
+            open(os.path.join(root, rel), "w").close()
+        self.assertEqual(kit.tracked_files(root), ["a.txt", "steps/01_x/x.cpp"])
+
+    def test_a_kit_needs_a_new_folder(self):
+        root = tempfile.mkdtemp()
+        with self.assertRaises(SystemExit):
+            kit.write_kit(root, root)
+        dest = tempfile.mkdtemp()
+        open(os.path.join(dest, "x"), "w").close()
+        with self.assertRaises(SystemExit) as e:
+            kit.write_kit(dest, root)
+        self.assertIn("exists and is not empty", str(e.exception))
+
+
+if __name__ == "__main__":
+    unittest.main()

@@ -302,7 +302,7 @@ def check_user_access(iso, work, secret):
     with tempfile.TemporaryDirectory(prefix="boxes-probe-") as folder:
         os.chmod(folder, 0o711)
         os.chown(folder, iso.user.uid, iso.user.gid)
-        r = sandbox.run([sys.executable, "-I", "-S", "-c", _ACCESS_PROBE] + paths,
+        r = sandbox.run([sandbox.USER_PYTHON, "-I", "-S", "-c", _ACCESS_PROBE] + paths,
                         sandbox.Limits(seconds=30, memory_mb=1024, output_mb=1), writable=[folder],
                         isolate=False, env=clean_env(folder), user=iso.user)
     try:

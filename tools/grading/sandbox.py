@@ -304,6 +304,9 @@ def _processes_of(uid, state=None):
     return found
 
 
+# A Python the user can run: the grader's own may live in root's home (pyenv, a venv).
+USER_PYTHON = shutil.which("python3", path="/usr/bin:/bin") or sys.executable
+
 # kill(-1) as the user: the kernel signals every process of that user in one pass (a fork
 # bomb cannot outrun it) and spares the caller.
 _KILLER = "import os\ntry:\n    os.kill(-1, 9)\nexcept OSError:\n    pass\n"
@@ -315,7 +318,7 @@ def kill_user(user):
     for attempt in range(100):
         if not _processes_of(user.uid):
             return 0
-        subprocess.run([sys.executable, "-I", "-S", "-c", _KILLER], user=user.uid, group=user.gid,
+        subprocess.run([USER_PYTHON, "-I", "-S", "-c", _KILLER], user=user.uid, group=user.gid,
                        extra_groups=[], env={}, stdin=subprocess.DEVNULL, stdout=subprocess.DEVNULL,
                        stderr=subprocess.DEVNULL, check=False)
         time.sleep(min(0.01 * attempt, 0.1))

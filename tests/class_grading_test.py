@@ -383,6 +383,32 @@ def scenario_gradescope_setup(work):
           f"reference: exercise {first} with its hidden test is shown after publishing, its public tests now")
     check("also have hidden tests" in doc.get("output", "") and f"{doc.get('score')} of" not in doc.get("output", ""),
           f"reference: the top-level output gives no total with the hidden points: {doc.get('output', '')[:200]!r}")
+    # results.json on every path: an overall time limit too short for the build (the kit
+    # compiles its own sources), a grader that fails (a config it cannot read), and a
+    # run_autograder whose Python does not start.
+    config = os.path.join(root, "source", "config.json")
+    saved = open(config).read()
+    try:
+        with open(config, "w") as f:
+            json.dump(dict(json.loads(saved), limit=1), f)
+        doc = gradescope_root_run(work, student_sources([]), "limit")
+        check(doc.get("score") == 0 and len(doc.get("tests", [])) >= len(step_ids()) and all(
+            "not graded: the grading ran past its overall time limit" in t["output"]
+            for t in doc["tests"] if t["number"] in step_ids()), "limit: every exercise says it was not graded in time")
+        with open(config, "w") as f:
+            f.write("{ not json")
+        doc = gradescope_root_run(work, student_sources([]), "grader failure")
+        check(doc.get("score") == 0 and "not a verdict on your code" in doc.get("output", ""),
+              f"grader failure: zero points and a message: {doc.get('output', '')[:120]!r}")
+    finally:
+        with open(config, "w") as f:
+            f.write(saved)
+    env = dict(root_env(work, root), PATH="/nonexistent")
+    r = subprocess.run(["/bin/bash", os.path.join(root, "run_autograder")], cwd=root, env=env, capture_output=True, text=True)
+    with open(os.path.join(root, "results", "results.json")) as f:
+        doc = json.load(f)
+    check(r.returncode == 0 and doc.get("score") == 0 and "failed before it could grade" in doc.get("output", ""),
+          f"no Python: run_autograder still writes results.json: {doc.get('output', '')[:120]!r}")
     return None
 
 

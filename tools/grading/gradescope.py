@@ -83,13 +83,13 @@ RUN_AUTOGRADER = """#!/usr/bin/env bash
 # /autograder/results/results.json. Written by the workbook's tools/grading/gradescope.py.
 root=$(cd "${AUTOGRADER_ROOT:-/autograder}" && pwd)
 results=$root/results/results.json
-rm -f "$results"
+mkdir -p "$root/results"
+: >"$results"  # a builtin: emptied even where nothing else runs
 (cd "$root/source/workbook" && python3 -m tools.grading.gradescope run --root "$root")
 status=$?
 # The grader writes results.json on every path it sees; this covers the ones it cannot
 # (it did not start, or was killed).
 if [[ ! -s $results ]]; then
-  mkdir -p "$root/results"
   printf '{"score": 0, "output_format": "text", "tests": [], "output": "%s (exit %s). %s"}\\n' \\
     "The autograder failed before it could grade this submission" "$status" \\
     "This is not a verdict on your code: your instructor sees the autograder's log." >"$results"

@@ -376,21 +376,32 @@ GRADING_CACHE = {"CMAKE_BUILD_TYPE": "Release", "CMAKE_CXX_FLAGS_RELEASE": GRADI
 
 def configure(work, iso):
     """Configures the grading tree once (sandboxed like the builds: it reads the reference's
-    CMake files, but writes only WORK/build); exits with the reason when that fails."""
+    CMake files, but writes only WORK/build); exits with the reason when that fails. Then
+    regenerates the build files if the CMake files changed (hidden tests added, say), so no
+    build needs to: CMake takes a source it cannot read for a missing one, and the hidden
+    tests are readable only now (CMake reads no file of the student's) and while they
+    compile."""
     build = os.path.join(work, "build")
     cache_file = os.path.join(build, "CMakeCache.txt")
     cache = read(cache_file).splitlines() if os.path.exists(cache_file) else []
     configured = {line.split("=", 1)[0].split(":")[0]: line.split("=", 1)[1] for line in cache
                   if "=" in line and not line.startswith(("//", "#"))}
-    if os.path.exists(os.path.join(build, "build.ninja")) and all(
-            configured.get(k) == v for k, v in GRADING_CACHE.items()):
-        return
-    say("configuring the grading tree (once; later grades reuse it)", iso.log)
+    fresh = os.path.exists(os.path.join(build, "build.ninja")) and all(
+        configured.get(k) == v for k, v in GRADING_CACHE.items())
     os.makedirs(build, exist_ok=True)
-    with building(work, iso):
-        r = sandboxed(["cmake", "-S", os.path.join(work, "src"), "-B", build, "-G", "Ninja"] +
-                      [f"-D{k}={v}" for k, v in GRADING_CACHE.items()], iso.build, iso, writable=[build],
-                      env=clean_env(build), readable=[os.path.join(work, "src")])
+    set_hidden_mode(work, 0o644)
+    try:
+        with building(work, iso):
+            if not fresh:
+                say("configuring the grading tree (once; later grades reuse it)", iso.log)
+                r = sandboxed(["cmake", "-S", os.path.join(work, "src"), "-B", build, "-G", "Ninja"] +
+                              [f"-D{k}={v}" for k, v in GRADING_CACHE.items()], iso.build, iso,
+                              writable=[build], env=clean_env(build), readable=[os.path.join(work, "src")])
+            else:
+                r = sandboxed(["cmake", "--build", build, "--target", "build.ninja"], iso.build, iso,
+                              writable=[build], env=clean_env(build), readable=[os.path.join(work, "src")])
+    finally:
+        set_hidden_mode(work, 0)
     if not r.ok:
         (iso.log or sys.stderr).write((r.stdout + r.stderr).decode(errors="replace"))
         raise GradeError(f"grade: configuring the grading tree failed ({r.reason}; see above)")

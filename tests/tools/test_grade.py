@@ -168,6 +168,29 @@ class PointsTable(unittest.TestCase):
         self.assertEqual(got[3]["details"], ["does not compile: y.cpp:1: error: no"])
 
 
+class StudentText(unittest.TestCase):
+    HOSTILE = "a\x1b[31mred\x00\x07\x0b\x0c\r\x7f\x85\ufffe\uffff\ud800 tab\tnewline\n\u00e9"
+
+    def test_what_xml_forbids_and_terminals_obey_is_written_out(self):
+        self.assertEqual(grade.printable(self.HOSTILE),
+                         "a\\x1b[31mred\\x00\\x07\\x0b\\x0c\\x0d\\x7f\\x85\\ufffe\\uffff\\ud800 tab\tnewline\n\u00e9")
+
+    def test_the_reports_stay_well_formed(self):
+        e = Exercise("1.1", "a sum", 1, "steps/01_x/x.cpp", 1, 0, 0)
+        o = CaseOutcome("edge " + self.HOSTILE, "failed", "failed: threw: " + self.HOSTILE, 0.5)
+        rows = [exercise_row(e, "01", "", [o], 0.5)]
+        folder = tempfile.mkdtemp()
+        grade.write_junit(os.path.join(folder, "g.xml"), rows, ["note " + self.HOSTILE], 1.0)
+        root = ET.parse(os.path.join(folder, "g.xml")).getroot()  # raises when not well-formed
+        failure = root.find(".//failure")
+        self.assertIn("\\x1b[31mred", failure.get("message"))
+        self.assertIn("\\x00", failure.text)
+        grade.write_json(os.path.join(folder, "g.json"), rows, ["note " + self.HOSTILE], 1.0)
+        with open(os.path.join(folder, "g.json"), encoding="utf-8") as f:
+            doc = json.load(f)
+        self.assertNotRegex(doc["exercises"][0]["reason"], "[\x00-\x08\x0b-\x1f\x7f\ufffe\ud800]")
+
+
 class GradingTree(unittest.TestCase):
     def test_hidden_test_names(self):
         hidden = tempfile.mkdtemp()

@@ -19,8 +19,15 @@ class ResultsJson(unittest.TestCase):
     def test_one_test_per_exercise_and_a_public_one_beside_hidden_tests(self):
         doc = gradescope.results_json(ROWS, CONFIG, ["a note"], 41.6)
         self.assertEqual((doc["score"], doc["execution_time"], doc["stdout_visibility"]), (1, 42, "hidden"))
-        self.assertTrue(doc["output"].startswith("1 of 3 points (steps 01);"))
+        # What students always see counts only the exercise without hidden tests.
+        self.assertTrue(doc["output"].startswith("0 of 2 points from the exercises without hidden tests "
+                                                 "(steps 01). Exercises 1.1 also have hidden tests: their "
+                                                 "points show after the due date."), doc["output"])
+        self.assertNotIn("1 of", doc["output"])
         self.assertTrue(doc["output"].endswith("note: a note\n"))
+        # Plain text: the output holds what the student's code printed and their file names.
+        self.assertEqual((doc["output_format"], doc["test_output_format"], doc["test_name_format"]),
+                         ("text", "text", "text"))
         tests = doc["tests"]
         self.assertEqual([(t["number"], t["score"], t["max_score"], t["status"], t["visibility"]) for t in tests],
                          [("1.1", 1, 1, "passed", "after_due_date"), ("1.1.0", 0, 0, "passed", "visible"),
@@ -29,6 +36,16 @@ class ResultsJson(unittest.TestCase):
         self.assertEqual(tests[2]["output"].split("\n"),
                          ["0 of 2 points: time limit", "first failure: slow: time limit", "FAILED: slow: time limit"])
         self.assertEqual(tests[0]["name"], "exercise 1.1: a sum")
+
+    def test_without_hidden_tests_the_total(self):
+        doc = gradescope.results_json(ROWS, dict(CONFIG, hidden_cases={}), [], 3)
+        self.assertTrue(doc["output"].startswith("1 of 3 points (steps 01). Each exercise"), doc["output"])
+        self.assertEqual([t["visibility"] for t in doc["tests"]], ["visible", "visible"])
+
+    def test_a_failure_is_zero_points_and_a_message(self):
+        doc = gradescope.failure(gradescope.GRADER_FAILED)
+        self.assertEqual((doc["score"], doc["tests"], doc["output_format"]), (0, [], "text"))
+        self.assertIn("not a verdict on your code", doc["output"])
 
     def test_hidden_case_names_per_exercise(self):
         hidden = tempfile.mkdtemp()

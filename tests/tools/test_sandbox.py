@@ -3,9 +3,11 @@ bubblewrap command line, the limits, and stopping every run."""
 import os
 import signal
 import sys
+import tempfile
 import threading
 import time
 import unittest
+from unittest import mock
 
 sys.path.insert(0, os.path.dirname(os.path.dirname(os.path.dirname(os.path.abspath(__file__)))))
 from tools.grading import sandbox  # noqa: E402
@@ -67,9 +69,54 @@ class BubblewrapPrefix(unittest.TestCase):
         self.assertLess(prefix.index("--bind"), prefix.index("--remount-ro"))
 
 
+class OlderBubblewrap(unittest.TestCase):
+    def test_options_it_lacks_are_left_out(self):
+        with mock.patch.object(sandbox, "bwrap_has", lambda option: False):  # Ubuntu 22.04's 0.6
+            prefix = sandbox.bwrap_prefix(["/w"], "/w", 1 << 20)
+        self.assertNotIn("--disable-userns", prefix)
+        self.assertNotIn("--size", prefix)
+        self.assertIn("--unshare-user", prefix)
+        self.assertEqual(prefix[prefix.index("--tmpfs") + 1], "/tmp")
+
+
+class CpuQuota(unittest.TestCase):
+    def layout(self, cgroup_lines, mounts, files):
+        root = tempfile.mkdtemp()
+        for rel, text in files.items():
+            os.makedirs(os.path.dirname(os.path.join(root, rel)), exist_ok=True)
+            with open(os.path.join(root, rel), "w") as f:
+                f.write(text)
+        with open(os.path.join(root, "cgroup"), "w") as f:
+            f.write(cgroup_lines)
+        with open(os.path.join(root, "mounts"), "w") as f:
+            f.write(mounts.replace("ROOT", root))
+        return os.path.join(root, "cgroup"), os.path.join(root, "mounts")
+
+    def test_cgroup_v2_in_a_container_and_on_a_host(self):
+        # A container's namespace shows its cgroup as /: the quota is at the mount's root.
+        args = self.layout("0::/\n", "cgroup2 ROOT/fs cgroup2 rw 0 0\n", {"fs/cpu.max": "50000 100000\n"})
+        self.assertEqual(sandbox.cgroup_cpu_quota(*args), 0.5)
+        # On a host: the tightest of the cgroup and its parents.
+        args = self.layout("0::/a/b\n", "cgroup2 ROOT/fs cgroup2 rw 0 0\n",
+                           {"fs/cpu.max": "max 100000\n", "fs/a/cpu.max": "150000 100000\n",
+                            "fs/a/b/cpu.max": "max 100000\n"})
+        self.assertEqual(sandbox.cgroup_cpu_quota(*args), 1.5)
+
+    def test_cgroup_v1_and_none(self):
+        args = self.layout("4:cpu,cpuacct:/docker/abc\n", "cgroup ROOT/cpu cgroup rw,cpu,cpuacct 0 0\n",
+                           {"cpu/cpu.cfs_quota_us": "200000\n", "cpu/cpu.cfs_period_us": "100000\n"})
+        self.assertEqual(sandbox.cgroup_cpu_quota(*args), 2.0)  # the path is not there: the mount's root
+        args = self.layout("4:cpu,cpuacct:/\n", "cgroup ROOT/cpu cgroup rw,cpu,cpuacct 0 0\n",
+                           {"cpu/cpu.cfs_quota_us": "-1\n", "cpu/cpu.cfs_period_us": "100000\n"})
+        self.assertIsNone(sandbox.cgroup_cpu_quota(*args))
+
+    def test_usable_cpus(self):
+        self.assertTrue(1 <= sandbox.usable_cpus() <= (os.cpu_count() or 1))
+
+
 class LimitsAndRuns(unittest.TestCase):
     def test_cpu_seconds_cover_every_core(self):
-        self.assertEqual(Limits(seconds=10).cpu_seconds(), 10 * (os.cpu_count() or 1) + 1)
+        self.assertEqual(Limits(seconds=10).cpu_seconds(), 10 * sandbox.usable_cpus() + 1)
 
     def test_a_run_without_isolation(self):
         r = sandbox.run(["sh", "-c", "echo hi; echo oops >&2; exit 4"], Limits(seconds=10), isolate=False)

@@ -192,7 +192,8 @@ def _first_failure(case):
 def _parse_results(path_or_text):
     """The root element, or None when the input cannot be read as XML."""
     try:
-        if isinstance(path_or_text, str) and path_or_text.lstrip().startswith("<"):
+        if isinstance(path_or_text, bytes) or (isinstance(path_or_text, str)
+                                                and path_or_text.lstrip().startswith("<")):
             if len(path_or_text) > MAX_RESULT_BYTES:
                 return None
             return ET.fromstring(path_or_text)
@@ -212,7 +213,7 @@ def _parse_results(path_or_text):
 
 
 def case_results(path_or_text):
-    """Every <TestCase> in one doctest XML file (or string starting with "<"): suite, name,
+    """Every <TestCase> in one doctest XML file (or string starting with "<", or bytes): suite, name,
     passed, message (one line; empty when passed).
 
     Never raises for what the file holds: a missing, unreadable, non-regular, truncated,

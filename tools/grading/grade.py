@@ -34,11 +34,14 @@ as JSON (exercise, title, step, points, max, status, reason, case, seconds).
 WORK/build is kept between runs, so grading the next tree rebuilds only what changed.
 """
 import argparse
+import contextlib
 import dataclasses
 import json
 import os
 import re
 import shutil
+import stat
+import subprocess
 import sys
 import tempfile
 import time
@@ -47,7 +50,8 @@ import xml.etree.ElementTree as ET
 from dataclasses import dataclass
 
 from . import ROOT, sandbox
-from .exercises import SOURCE_SUFFIXES, case_results, exercises, step_dirs
+from .exercises import (BEGIN, MAX_RESULT_BYTES, SOURCE_SUFFIXES, case_results, exercises, step_dirs,
+                        step_sources)
 from .kit import strip_solutions, tracked_files
 
 
@@ -64,6 +68,19 @@ class GradeError(Exception):
 class OutOfTime(Exception):
     """The whole grading of one tree passed its deadline (the class grader's
     --student-timeout)."""
+
+
+# What XML 1.0 forbids (C0 controls but tab and newline here, also carriage return; U+FFFE,
+# U+FFFF; lone surrogates), and DEL and the C1 controls, which drive terminals.
+_UNPRINTABLE = re.compile("[\x00-\x08\x0b-\x1f\x7f-\x9f\ud800-\udfff\ufffe\uffff]")
+
+
+def printable(text):
+    """text with each such character written as \\xNN or \\uNNNN: what the student's code prints,
+    throws or names goes into the JUnit XML (which must stay well-formed), the JSON and the
+    instructor's terminal."""
+    return _UNPRINTABLE.sub(lambda m: f"\\x{ord(m.group()):02x}" if ord(m.group()) < 0x100
+                            else f"\\u{ord(m.group()):04x}", text)
 
 
 def say(text, log=None):
@@ -133,8 +150,30 @@ def sync_tree(dest, files):
             os.rmdir(d)
 
 
+HIDDEN_DIR = "tests/hidden"  # where the grading tree keeps the hidden tests
+
+
+def hidden_copies(work, number=None):
+    """The grading tree's copies of the hidden tests (of step `number`, or all)."""
+    folder = os.path.join(work, "src", HIDDEN_DIR)
+    if not os.path.isdir(folder):
+        return []
+    return [os.path.join(folder, n) for n in sorted(os.listdir(folder))
+            if number is None or n.startswith(f"step{number}_")]
+
+
+def set_hidden_mode(work, mode, number=None):
+    """chmod the hidden tests' copies: 0 while student code runs or a student's own source
+    compiles (not even their owner may read them then: bubblewrap's nobody is the grader
+    outside), readable only while they compile themselves."""
+    for path in hidden_copies(work, number):
+        os.chmod(path, mode)
+
+
 def assemble(student, hidden, work, steps):
-    """Writes the grading tree into work/src; returns the notes for the report."""
+    """Writes the grading tree into work/src; returns the notes for the report. The hidden
+    tests' copies get neutral names (tests/hidden/stepNN_K.cpp: nothing in the tree says
+    what the instructor called them) and are left unreadable (set_hidden_mode)."""
     notes = []
     step_names = [os.path.basename(d) for d in step_dirs(ROOT)]
     files = {}
@@ -159,15 +198,19 @@ def assemble(student, hidden, work, steps):
     for number, names in by_step.items():
         if number not in steps:
             continue
-        for n in names:
+        copies = []
+        for k, n in enumerate(names):
             with open(os.path.join(hidden, n), "rb") as f:
-                files[f"tests/hidden/{n}"] = f.read()
-        sources = " ".join(f"hidden/{n}" for n in names)
+                files[f"{HIDDEN_DIR}/step{number}_{k}.cpp"] = f.read()
+            copies.append(f"hidden/step{number}_{k}.cpp")
+        sources = " ".join(copies)
         extra.append(f"if(TARGET test_step{number})\n    target_sources(test_step{number} PRIVATE {sources})\nendif()")
         notes.append(f"hidden tests for step {number}: {', '.join(names)}")
     if len(extra) > 2:
         files["tests/CMakeLists.txt"] += ("\n".join(extra) + "\n").encode()
+    set_hidden_mode(work, 0o600)  # the grader compares and rewrites them
     sync_tree(os.path.join(work, "src"), files)
+    set_hidden_mode(work, 0)
     return notes
 
 
@@ -187,6 +230,95 @@ class Isolation:
     hidden: tuple = ()
     deadline: float = None  # time.monotonic() by which the whole grading ends (None: none)
     log: object = None  # where progress goes (None: stderr)
+    # Without isolation, as root: the unprivileged user student code runs as (a
+    # sandbox.User). The grading tree is then readable to it, the build folder its own only
+    # while it builds, each test case's folder its own; the rest is the grader's.
+    user: sandbox.User = None
+
+    @property
+    def drop(self):
+        return self.user is not None and not self.isolate
+
+
+def chown_tree(path, uid, gid):
+    """chown -R without following links."""
+    os.lchown(path, uid, gid)
+    for d, dirs, files in os.walk(path):
+        for n in dirs + files:
+            os.lchown(os.path.join(d, n), uid, gid)
+
+
+@contextlib.contextmanager
+def building(work, iso):
+    """While a configure or a build runs: WORK/build is the student user's (its compilers
+    write there), afterwards the grader's again, so that the tests, which run the student's
+    code as that user, cannot change what later builds and tests use."""
+    build = os.path.join(work, "build")
+    if not iso.drop:
+        yield
+        return
+    chown_tree(build, iso.user.uid, iso.user.gid)
+    try:
+        yield
+    finally:
+        chown_tree(build, os.getuid(), os.getgid())
+
+
+def share_tree(src):
+    """The grading tree readable to everyone (the compilers run as the student user; root's
+    umask may be 077), but for the hidden tests (set_hidden_mode)."""
+    os.chmod(src, 0o755)
+    for d, dirs, files in os.walk(src):
+        if os.path.relpath(d, src) == HIDDEN_DIR:
+            continue
+        for n in dirs:
+            os.chmod(os.path.join(d, n), 0o755)
+        for n in files:
+            path = os.path.join(d, n)
+            if not os.path.islink(path):
+                os.chmod(path, 0o755 if os.stat(path).st_mode & 0o100 else 0o644)
+
+
+# Run as the student user: which of the paths it can open (a folder: list).
+_ACCESS_PROBE = """import json, os, sys
+seen = {}
+for p in sys.argv[1:]:
+    try:
+        os.listdir(p) if os.path.isdir(p) else open(p, "rb").close()
+        seen[p] = True
+    except OSError:
+        seen[p] = False
+print(json.dumps(seen))
+"""
+
+
+def check_user_access(iso, work, secret):
+    """Asks the student user itself (a command in the sandbox, as the tests run) what it can
+    read: the grading tree it must, the reference tree and the hidden tests it must not.
+    Raises GradeError (exit 2) naming what is wrong."""
+    src = os.path.join(work, "src")
+    wanted = [src, os.path.join(src, "CMakeLists.txt")]
+    paths = wanted + [p for p in secret if p and os.path.exists(p)]
+    with tempfile.TemporaryDirectory(prefix="boxes-probe-") as folder:
+        os.chmod(folder, 0o711)
+        os.chown(folder, iso.user.uid, iso.user.gid)
+        r = sandbox.run([sandbox.USER_PYTHON, "-I", "-S", "-c", _ACCESS_PROBE] + paths,
+                        sandbox.Limits(seconds=30, memory_mb=1024, output_mb=1), writable=[folder],
+                        isolate=False, env=clean_env(folder), user=iso.user)
+    try:
+        seen = json.loads(r.stdout.decode())
+    except ValueError:
+        raise GradeError(f"grade: cannot run commands as user {iso.user.name} ({r.reason}: "
+                         f"{r.stderr.decode(errors='replace').strip()[-200:]})", 2) from None
+    for p in wanted:
+        if not seen.get(p):
+            raise GradeError(f"grade: user {iso.user.name} cannot read the grading tree {src}: "
+                             "every folder above it must let others in (chmod o+x)", 2)
+    for p in paths[len(wanted):]:
+        if seen.get(p):
+            raise GradeError(f"grade: user {iso.user.name} can read {p}: the reference solutions "
+                             "and the hidden tests must be out of its reach (chmod o-rwx on it or "
+                             "a folder above it)", 2)
 
 
 def sandboxed(cmd, limits, iso, **kw):
@@ -198,7 +330,8 @@ def sandboxed(cmd, limits, iso, **kw):
             raise OutOfTime()
         if left < limits.seconds:
             limits = dataclasses.replace(limits, seconds=left)
-    r = sandbox.run(cmd, limits, isolate=iso.isolate, hidden=iso.hidden, **kw)
+    r = sandbox.run(cmd, limits, isolate=iso.isolate, hidden=iso.hidden,
+                    user=iso.user if iso.drop else None, **kw)
     if iso.deadline is not None and time.monotonic() >= iso.deadline:
         raise OutOfTime()
     return r
@@ -235,27 +368,40 @@ def build_reason(result, output, src):
 # the same (no -ffast-math either way, so the same IEEE arithmetic).
 GRADING_FLAGS = "-O1 -DNDEBUG"
 # How the grading tree is configured: BOXES_GRADING (no ctest discovery, which would run the
-# student's code in the build) and no step programs (the grader runs only exercise suites).
+# student's code in the build), no step programs (the grader runs only exercise suites) and
+# so no window (no SDL2, Dear ImGui or OpenGL to install where it grades).
 GRADING_CACHE = {"CMAKE_BUILD_TYPE": "Release", "CMAKE_CXX_FLAGS_RELEASE": GRADING_FLAGS,
-                 "BOXES_GRADING": "ON", "BOXES_TESTS_BUILD_PROGRAMS": "OFF"}
+                 "BOXES_GRADING": "ON", "BOXES_TESTS_BUILD_PROGRAMS": "OFF", "BOXES_WINDOW": "OFF"}
 
 
 def configure(work, iso):
     """Configures the grading tree once (sandboxed like the builds: it reads the reference's
-    CMake files, but writes only WORK/build); exits with the reason when that fails."""
+    CMake files, but writes only WORK/build); exits with the reason when that fails. Then
+    regenerates the build files if the CMake files changed (hidden tests added, say), so no
+    build needs to: CMake takes a source it cannot read for a missing one, and the hidden
+    tests are readable only now (CMake reads no file of the student's) and while they
+    compile."""
     build = os.path.join(work, "build")
     cache_file = os.path.join(build, "CMakeCache.txt")
     cache = read(cache_file).splitlines() if os.path.exists(cache_file) else []
     configured = {line.split("=", 1)[0].split(":")[0]: line.split("=", 1)[1] for line in cache
                   if "=" in line and not line.startswith(("//", "#"))}
-    if os.path.exists(os.path.join(build, "build.ninja")) and all(
-            configured.get(k) == v for k, v in GRADING_CACHE.items()):
-        return
-    say("configuring the grading tree (once; later grades reuse it)", iso.log)
+    fresh = os.path.exists(os.path.join(build, "build.ninja")) and all(
+        configured.get(k) == v for k, v in GRADING_CACHE.items())
     os.makedirs(build, exist_ok=True)
-    r = sandboxed(["cmake", "-S", os.path.join(work, "src"), "-B", build, "-G", "Ninja"] +
-                  [f"-D{k}={v}" for k, v in GRADING_CACHE.items()], iso.build, iso, writable=[build],
-                  env=clean_env(build), readable=[os.path.join(work, "src")])
+    set_hidden_mode(work, 0o644)
+    try:
+        with building(work, iso):
+            if not fresh:
+                say("configuring the grading tree (once; later grades reuse it)", iso.log)
+                r = sandboxed(["cmake", "-S", os.path.join(work, "src"), "-B", build, "-G", "Ninja"] +
+                              [f"-D{k}={v}" for k, v in GRADING_CACHE.items()], iso.build, iso,
+                              writable=[build], env=clean_env(build), readable=[os.path.join(work, "src")])
+            else:
+                r = sandboxed(["cmake", "--build", build, "--target", "build.ninja"], iso.build, iso,
+                              writable=[build], env=clean_env(build), readable=[os.path.join(work, "src")])
+    finally:
+        set_hidden_mode(work, 0)
     if not r.ok:
         (iso.log or sys.stderr).write((r.stdout + r.stderr).decode(errors="replace"))
         raise GradeError(f"grade: configuring the grading tree failed ({r.reason}; see above)")
@@ -274,20 +420,59 @@ def first_error(output, src):
     return "the build failed"
 
 
+def write_private(path, text):
+    """A file only the grader reads (a build log may quote the hidden tests)."""
+    fd = os.open(path, os.O_WRONLY | os.O_CREAT | os.O_TRUNC, 0o600)
+    os.fchmod(fd, 0o600)  # an older one may have been readable
+    with os.fdopen(fd, "w") as f:
+        f.write(text)
+
+
+def cmake_build(work, targets, iso):
+    """Builds targets (names, or object files by their path in WORK/build) in the sandbox: the
+    compilers run on the student's sources, so the build writes only WORK/build, within the
+    build limits."""
+    build = os.path.join(work, "build")
+    with building(work, iso):
+        return sandboxed(["cmake", "--build", build, "--target", *targets, "--", f"-j{iso.jobs}"],
+                         iso.build, iso, writable=[build], env=clean_env(build),
+                         readable=[os.path.join(work, "src")])
+
+
 def build_step(work, number, iso):
     """'' when test_stepNN builds, else the reason it does not ('does not compile: ...').
-    The compilers run on the student's sources, so the build is sandboxed: it writes only
-    WORK/build, within the build limits."""
-    build = os.path.join(work, "build")
-    r = sandboxed(["cmake", "--build", build, "--target", f"test_step{number}", "--", f"-j{iso.jobs}"],
-                  iso.build, iso, writable=[build], env=clean_env(build),
-                  readable=[os.path.join(work, "src")])
-    if r.ok:
+
+    The step's hidden tests compile first, on their own: only then may they be read, and what
+    the compiler says of them (the student's headers can make it quote them) goes to the
+    instructor's log, never into the reason. The rest of the build cannot read them."""
+    src = os.path.join(work, "src")
+    name = next(os.path.basename(d) for d in step_dirs(ROOT) if os.path.basename(d).startswith(number))
+    hidden_failed = None
+    copies = hidden_copies(work, number)
+    if copies:
+        set_hidden_mode(work, 0o644, number)
+        try:
+            r = cmake_build(work, [f"tests/CMakeFiles/test_step{number}.dir/{HIDDEN_DIR[6:]}/"
+                                   f"{os.path.basename(c)}.o" for c in copies], iso)
+        finally:
+            set_hidden_mode(work, 0, number)
+        if not r.ok:
+            write_private(os.path.join(work, f"build-step{number}-hidden.log"),
+                          (r.stdout + r.stderr).decode(errors="replace") + f"\n[grade] build result: {r.reason}\n")
+            hidden_failed = r
+    # Without the hidden tests' objects test_stepNN cannot link: then the student's own
+    # sources and the public tests, whose errors the student may see.
+    targets = ([f"step{name}", f"tests/CMakeFiles/test_step{number}.dir/step{name}.cpp.o"]
+               if hidden_failed else [f"test_step{number}"])
+    r = cmake_build(work, targets, iso)
+    if r.ok and not hidden_failed:
         return ""
+    if r.ok:
+        return (f"does not compile: step {number}'s hidden tests do not compile with these sources "
+                f"({hidden_failed.reason}; the compiler's messages are for the instructor)")
     output = (r.stdout + r.stderr).decode(errors="replace")
-    with open(os.path.join(work, f"build-step{number}.log"), "w") as f:
-        f.write(output + f"\n[grade] build result: {r.reason}\n")
-    return build_reason(r, output, os.path.join(work, "src"))
+    write_private(os.path.join(work, f"build-step{number}.log"), output + f"\n[grade] build result: {r.reason}\n")
+    return build_reason(r, output, src)
 
 
 def test_readable(binary):
@@ -299,6 +484,8 @@ def test_readable(binary):
 def list_cases(binary, iso, folder):
     """[(suite, test case)] of a test program, or raises RuntimeError saying why not."""
     os.makedirs(folder, exist_ok=True)
+    if iso.drop:
+        os.chown(folder, iso.user.uid, iso.user.gid)
     limits = iso.test
     r = sandboxed([binary, "--list-test-cases", "--reporters=xml"], limits, iso, writable=[folder],
                   env=clean_env(folder), keep=int(limits.output_mb * (1 << 20)),
@@ -341,16 +528,33 @@ def run_case(binary, suite, name, iso, folder):
     limits. doctest writes its results to a file there, so what the student's code prints is
     only counted against the output limit, never read as a result."""
     os.makedirs(folder)
+    if iso.drop:
+        os.chown(folder, iso.user.uid, iso.user.gid)
     result = os.path.join(folder, "result.xml")
     cmd = [binary, "--test-suite=" + doctest_filter(suite), "--test-case=" + doctest_filter(name),
            "--reporters=xml", "--no-version", f"--out={result}"]
     try:
         r = sandboxed(cmd, iso.test, iso, writable=[folder], env=clean_env(folder), keep=1 << 16,
                       readable=test_readable(binary))
-        found = [c for c in case_results(result) if c.name == name] if os.path.exists(result) else []
+        data = read_result(result)
+        found = [c for c in case_results(data) if c.name == name] if data else []
     finally:
         shutil.rmtree(folder, ignore_errors=True)
     return case_outcome(name, r, found)
+
+
+def read_result(path):
+    """The bytes of a test's result file, or None. The folder was the student code's: a link
+    there is not followed (the grader may read what the student may not), nor a FIFO."""
+    try:
+        fd = os.open(path, os.O_RDONLY | os.O_NOFOLLOW | os.O_NONBLOCK)
+    except OSError:
+        return None
+    with os.fdopen(fd, "rb") as f:
+        info = os.fstat(f.fileno())
+        if not stat.S_ISREG(info.st_mode) or info.st_size > MAX_RESULT_BYTES:
+            return None
+        return f.read(MAX_RESULT_BYTES + 1)
 
 
 def case_outcome(name, r, found):
@@ -410,14 +614,14 @@ def write_junit(path, rows, notes, seconds):
                               name=f"exercise {r['id']}: {r['title']} ({r['points']} point{'s' if r['points'] != 1 else ''})",
                               time=f"{r['seconds']:.2f}")
             if not r["passed"]:
-                f = ET.SubElement(c, "failure", message=r["message"], type="failed")
-                f.text = "\n".join(r["details"]) or r["message"]
+                f = ET.SubElement(c, "failure", message=printable(r["message"]), type="failed")
+                f.text = printable("\n".join(r["details"]) or r["message"])
             else:
-                ET.SubElement(c, "system-out").text = "\n".join(r["details"])
+                ET.SubElement(c, "system-out").text = printable("\n".join(r["details"]))
         earned = sum(r["points"] for r in items if r["passed"])
         ET.SubElement(s, "system-out").text = (
             f"step {step}: {earned} of {sum(r['points'] for r in items)} points\n" +
-            "".join(f"note: {n}\n" for n in notes))
+            "".join(f"note: {printable(n)}\n" for n in notes))
     ET.indent(suites)
     os.makedirs(os.path.dirname(os.path.abspath(path)), exist_ok=True)
     ET.ElementTree(suites).write(path, encoding="utf-8", xml_declaration=True)
@@ -457,9 +661,10 @@ def exercise_row(e, number, build_error, outcomes, seconds):
         status, reason, case = failed[0].status, failed[0].reason, failed[0].name
     else:
         status, reason, case = "passed", "", ""
+    reason = printable(reason)
     reason = reason if len(reason) <= 500 else reason[:497] + "..."
     message = reason + (f' (test case "{case}")' if case else "")
-    details = [f"{'passed' if o.passed else 'FAILED'}: {o.name}" + ("" if o.passed else f": {o.reason}")
+    details = [printable(f"{'passed' if o.passed else 'FAILED'}: {o.name}" + ("" if o.passed else f": {o.reason}"))
                for o in outcomes] or [message]
     return {"id": e.id, "title": e.title, "points": e.points, "step": number,
             "passed": status == "passed", "status": status, "reason": reason, "case": case,
@@ -495,6 +700,8 @@ class GradeOptions:
     work: str = None  # the grading tree and its build (None: build/grade)
     jobs: int = 2  # parallel compile jobs
     no_isolation: bool = False  # without bubblewrap (the limits still hold)
+    user: str = None  # without bubblewrap, as root: the unprivileged user student code runs as
+    private: tuple = ()  # more paths that user must not read (the class grader's results)
 
 
 @dataclass
@@ -507,11 +714,53 @@ class Graded:
     junit: str  # where the JUnit XML went
 
 
-def grade(student, opts, out=None, log=None, deadline=None):
+def solution_files(root=ROOT):
+    """The step sources (and headers) of `root` that hold a solution block, relative to it."""
+    found = []
+    for path in step_sources(root):
+        with open(path, encoding="utf-8", errors="replace") as f:
+            if any(BEGIN.match(line) for line in f):
+                found.append(os.path.relpath(path, root))
+    return found
+
+
+def scrub_solution_outputs(work, log=None):
+    """After grading the reference: removes from WORK/build what was compiled from its
+    solutions (the objects of sources that hold a solution block or include a header that
+    does, and the libraries and test programs that contain them), so that no student graded
+    next in this folder can read them. Their own build compiles those again anyway; the
+    core, the tests and the other sources stay built."""
+    build = os.path.join(work, "build")
+    src = os.path.join(work, "src")
+    solved = {os.path.normpath(os.path.join(src, rel)) for rel in solution_files()}
+    ninja = shutil.which("ninja") or shutil.which("ninja-build")
+    r = subprocess.run([ninja or "ninja", "-C", build, "-t", "deps"], capture_output=True, text=True)
+    if r.returncode != 0:
+        say(f"cannot list the build's dependencies ({r.stderr.strip()[:200]}): removing every object "
+            "of the steps' sources and the tests", log)
+    doomed, target = set(), None
+    for line in r.stdout.splitlines():
+        if line and not line.startswith(" "):
+            target = line.split(":", 1)[0]
+        elif line.strip() and target:
+            if os.path.normpath(os.path.join(build, line.strip())) in solved:
+                doomed.add(target)
+    for d, _, files in os.walk(build):
+        for n in files:
+            path = os.path.join(d, n)
+            rel = os.path.relpath(path, build)
+            whole_step = r.returncode != 0 and rel.startswith(("steps/", "tests/")) and n.endswith(".o")
+            program = rel.startswith("tests/test_step") and os.sep not in rel[len("tests/"):]
+            if rel in doomed or whole_step or n.endswith(".a") or program:
+                os.remove(path)
+
+
+def grade(student, opts, out=None, log=None, deadline=None, partial=False):
     """Grades the tree `student` with GradeOptions `opts`: the points table to `out`
     (default stdout), progress to `log` (default stderr), the JUnit XML (and the JSON) to
     their files. Raises GradeError when grading cannot start or go on, OutOfTime once
-    time.monotonic() passes `deadline`, sandbox.Stopped after sandbox.stop_all()."""
+    time.monotonic() passes `deadline` (with `partial`: the exercises not graded by then
+    fail with that reason instead), sandbox.Stopped after sandbox.stop_all()."""
     started = time.monotonic()
     out = out or sys.stdout
     student_path = os.path.abspath(student)
@@ -526,43 +775,56 @@ def grade(student, opts, out=None, log=None, deadline=None):
         raise GradeError(f"grade: --steps {','.join(unknown)}: no such step with exercises "
                          f"(steps: {','.join(numbers)})")
     refuse_without_isolation(opts, log)
+    user = None
+    if opts.no_isolation and opts.user:
+        if os.geteuid() != 0:
+            raise GradeError("grade: --user runs student code as another user: that needs root", 2)
+        try:
+            user = sandbox.grading_user(opts.user)
+        except ValueError as e:
+            raise GradeError(f"grade: --user: {e}", 2) from None
+    elif opts.no_isolation and os.geteuid() == 0:
+        say("WARNING: as root without --user, student code runs as root", log)
     hidden = opts.hidden and os.path.abspath(opts.hidden)
     unreadable = (ROOT, student_path, hidden, os.path.expanduser("~"), "/home", "/root")
     iso = Isolation(not opts.no_isolation,
                     build=sandbox.Limits(opts.build_timeout, opts.build_memory, opts.output, file_mb=2048),
                     test=sandbox.Limits(opts.timeout, opts.memory, opts.output), jobs=opts.jobs,
-                    hidden=tuple(dict.fromkeys(p for p in unreadable if p)), deadline=deadline, log=log)
+                    hidden=tuple(dict.fromkeys(p for p in unreadable if p)), deadline=deadline, log=log,
+                    user=user)
+    os.makedirs(work, exist_ok=True)
     notes = assemble(student_path, hidden, work, steps)
-    if not iso.isolate:
+    if iso.drop:
+        os.chmod(work, 0o755)
+        share_tree(os.path.join(work, "src"))
+        solutions = [os.path.join(ROOT, rel) for rel in solution_files()[:1]]
+        check_user_access(iso, work, solutions + [hidden] + hidden_copies(work) + list(opts.private))
+        notes.append(f"student code ran without isolation, as user {user.name}")
+    elif not iso.isolate:
         notes.append("student code ran without isolation (--no-isolation)")
     configure(work, iso)
     rows = []
     with tempfile.TemporaryDirectory(prefix="boxes-grade-") as scratch:
-        for number in steps:
+        if iso.drop:
+            os.chmod(scratch, 0o711)  # the user reaches its case folders, lists nothing
+        for k, number in enumerate(steps):
             items = [e for e in all_ex if f"{e.step:02d}" == number]
             say(f"step {number}: building test_step{number}", log)
             t0 = time.monotonic()
-            error = build_step(work, number, iso)
-            outcomes = {e.id: [] for e in items}
-            if not error:
-                binary = os.path.join(work, "build", "tests", f"test_step{number}")
-                try:
-                    cases = [(s, n) for s, n in list_cases(binary, iso, os.path.join(scratch, "list"))
-                             if s.startswith("exercise ")]
-                except RuntimeError as e:
-                    error, cases = tuple(e.args), []
-                say(f"step {number}: running {len(cases)} test cases", log)
-                for i, (suite, name) in enumerate(cases):
-                    ex = suite.split(" ", 1)[1]
-                    if ex not in outcomes:
-                        notes.append(f"suite '{suite}' has no exercise marker: not counted")
-                        outcomes[ex] = []
-                    o = run_case(binary, suite, name, iso, os.path.join(scratch, f"{number}-{i}"))
-                    if not o.passed:
-                        say(f"step {number}: {name}: {o.reason}", log)
-                    outcomes[ex].append(o)
-            for e in items:
-                rows.append(exercise_row(e, number, error, outcomes[e.id], time.monotonic() - t0))
+            try:
+                step_rows = grade_step(work, number, items, iso, scratch, notes, log, t0)
+            except OutOfTime:
+                if not partial:
+                    raise
+                why = ("time limit", "not graded: the grading ran past its overall time limit")
+                for later in steps[k:]:
+                    rows += [exercise_row(e, later, why, [], 0.0) for e in all_ex if f"{e.step:02d}" == later]
+                say(f"out of time at step {number}: its exercises and the later ones are not graded", log)
+                break
+            rows += step_rows
+    notes = [printable(n) for n in notes]
+    if student_path == ROOT:
+        scrub_solution_outputs(work, log)
     earned, total = print_table(rows, notes, out)
     junit = opts.junit or os.path.join(work, "grade.xml")
     write_junit(junit, rows, notes, time.monotonic() - started)
@@ -570,6 +832,30 @@ def grade(student, opts, out=None, log=None, deadline=None):
         write_json(opts.json, rows, notes, time.monotonic() - started)
     say(f"{earned} of {total} points; JUnit XML: {junit}", log)
     return Graded(rows, notes, earned, total, junit)
+
+
+def grade_step(work, number, items, iso, scratch, notes, log, t0):
+    """The rows of one step's exercises: its build, then each exercise case on its own."""
+    error = build_step(work, number, iso)
+    outcomes = {e.id: [] for e in items}
+    if not error:
+        binary = os.path.join(work, "build", "tests", f"test_step{number}")
+        try:
+            cases = [(s, n) for s, n in list_cases(binary, iso, os.path.join(scratch, "list"))
+                     if s.startswith("exercise ")]
+        except RuntimeError as e:
+            error, cases = tuple(e.args), []
+        say(f"step {number}: running {len(cases)} test cases", log)
+        for i, (suite, name) in enumerate(cases):
+            ex = suite.split(" ", 1)[1]
+            if ex not in outcomes:
+                notes.append(f"suite '{suite}' has no exercise marker: not counted")
+                outcomes[ex] = []
+            o = run_case(binary, suite, name, iso, os.path.join(scratch, f"{number}-{i}"))
+            if not o.passed:
+                say(printable(f"step {number}: {name}: {o.reason}"), log)
+            outcomes[ex].append(o)
+    return [exercise_row(e, number, error, outcomes[e.id], time.monotonic() - t0) for e in items]
 
 
 def results_by_exercise(rows):
@@ -600,11 +886,12 @@ class Report:
     last_line: str  # the log's last line (why, when code is not 0)
 
 
-def grade_into(folder, tree, opts, limit=None):
+def grade_into(folder, tree, opts, limit=None, partial=False):
     """Grades `tree` in-process into `folder`, as the class grader and Gradescope keep a
     grade: points.txt (the table), grade.log (the progress), grade.xml and grade.json. A
     failure to grade is a Report with its code and the log's last line, not an exception;
-    `limit`: seconds for the whole grading (OutOfTime: code None). sandbox.Stopped passes."""
+    `limit`: seconds for the whole grading (OutOfTime: code None; with `partial`, the
+    exercises not graded in time fail instead). sandbox.Stopped passes."""
     os.makedirs(folder, exist_ok=True)
     opts = dataclasses.replace(opts, junit=os.path.join(folder, "grade.xml"),
                                json=os.path.join(folder, "grade.json"))
@@ -617,7 +904,7 @@ def grade_into(folder, tree, opts, limit=None):
     with open(os.path.join(folder, "points.txt"), "w") as out, \
             open(os.path.join(folder, "grade.log"), "w") as log:
         try:
-            graded = grade(tree, opts, out, log, deadline)
+            graded = grade(tree, opts, out, log, deadline, partial)
         except OutOfTime:
             code = None
         except (GradeError, SystemExit) as e:
@@ -661,11 +948,15 @@ def main(argv):
     p.add_argument("--no-isolation", "--no-sandbox", dest="no_isolation", action="store_true",
                    help="build and run student code WITHOUT bubblewrap (the limits still hold); "
                         "only for code you trust, where bubblewrap cannot run")
+    p.add_argument("--user", help="with --no-isolation, as root: build and run student code as this "
+                                  "unprivileged user, which must not be able to read this tree; every "
+                                  "process of it is killed after each command")
     args = p.parse_args(argv)
     for flag in ("timeout", "memory", "output", "build_timeout", "build_memory", "jobs"):
         if getattr(args, flag) <= 0:
             p.error(f"--{flag.replace('_', '-')} must be positive")
-    opts = GradeOptions(**{f.name: getattr(args, f.name) for f in dataclasses.fields(GradeOptions)})
+    opts = GradeOptions(**{f.name: getattr(args, f.name) for f in dataclasses.fields(GradeOptions)
+                           if hasattr(args, f.name)})
     opts.steps = [s.zfill(2) for s in args.steps.split(",")] if args.steps else None
     try:
         grade(args.student, opts)

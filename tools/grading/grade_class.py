@@ -50,13 +50,14 @@ def say(text):
 
 
 def run_grader(tree, work, report_dir, steps=None, hidden=None, timeout=60.0, jobs=1,
-               no_sandbox=False, limit=None):
+               no_sandbox=False, limit=None, user=None, partial=False):
     """Grades one tree in-process into report_dir (points.txt, grade.log, grade.xml,
     grade.json) in the grading folder `work`; returns grade.Report (code None: it ran out of
-    `limit` seconds)."""
+    `limit` seconds; with `partial` the exercises not graded by then fail instead). `user`:
+    without the sandbox, as root, the unprivileged user student code runs as."""
     opts = GradeOptions(work=work, timeout=timeout, jobs=jobs, steps=steps, hidden=hidden,
-                        no_isolation=no_sandbox)
-    return grade_into(report_dir, tree, opts, limit)
+                        no_isolation=no_sandbox, user=user)
+    return grade_into(report_dir, tree, opts, limit, partial)
 
 
 # The class --------------------------------------------------------------------------------
@@ -297,7 +298,7 @@ def grade_class(opts):
     opts.all_ex = {e.id: e for e in all_ex}
     opts.hidden = os.path.abspath(opts.hidden) if opts.hidden else None
     opts.jobs = max(1, opts.jobs)
-    opts.compile_jobs = max(1, (os.cpu_count() or 1) // opts.jobs)
+    opts.compile_jobs = max(1, sandbox.usable_cpus() // opts.jobs)
     key = config_hash(opts.hidden, opts.steps, opts.timeout)
 
     subs = discover(opts.submissions)
@@ -394,8 +395,8 @@ def main(argv):
     p.add_argument("submissions", help="folder with one folder, git repository or archive per student")
     p.add_argument("--out", default=os.path.join(ROOT, "build", "class-grades"),
                    help="where the results go (default build/class-grades)")
-    p.add_argument("--jobs", type=int, default=os.cpu_count() or 1,
-                   help="students graded at once (default: the number of cores)")
+    p.add_argument("--jobs", type=int, default=sandbox.usable_cpus(),
+                   help="students graded at once (default: the cores this process may use)")
     p.add_argument("--hidden", help="folder of extra doctest files stepNN*.cpp (as for grade)")
     p.add_argument("--steps", help="grade only these steps, e.g. 01,03")
     p.add_argument("--timeout", type=float, default=60.0, help="seconds per test case (default 60)")

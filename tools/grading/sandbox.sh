@@ -1,7 +1,7 @@
 #!/usr/bin/env bash
 # Runs one untrusted command isolated and limited (for the grader: student builds and tests).
 # usage: tools/grading/sandbox.sh [--time SECONDS] [--memory MB] [--output MB] [--processes N]
-#                                 [--dir DIR] [--no-isolation] -- COMMAND [ARGS...]
+#                                 [--dir DIR] [--no-isolation [--user NAME]] -- COMMAND [ARGS...]
 # Isolation (bubblewrap): the whole system read-only, DIR (default: a fresh temporary
 # folder) the only writable place and the working directory, a private /tmp, no network,
 # own PID and user namespace without capabilities, killed with this script. Limits:
@@ -10,6 +10,8 @@
 # output limit). Prints one line "sandbox: RESULT" on stdout: ok | failed: exit N |
 # time limit | memory limit | output limit | crashed: SIGNAME. Exit status: 0 ok, 1 failed,
 # 3 limit or crash, 2 usage or refused (no user namespaces and no --no-isolation).
+# --user NAME (with --no-isolation, as root): the command runs as that unprivileged user,
+# and every process of that user is killed when it ends.
 # The one implementation is sandbox.py beside this (the grader imports it); this is its
 # wrapper. sandbox.py imports nothing of the workbook, so it runs as a script from the
 # caller's folder (DIR and the command's paths are the caller's).

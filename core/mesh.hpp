@@ -19,8 +19,8 @@ struct InputError : std::runtime_error {
 };
 
 // User text quoted in such a message: control bytes escaped as \xNN so the message stays
-// one line (issue 10's fuzzing found names with newlines cutting messages short), and at
-// most `max` characters (then "...").
+// one line (a name with a newline would cut it short), and at most `max` characters (then
+// "...").
 std::string printable(std::string_view text, size_t max = 60);
 
 struct Mesh {
@@ -43,7 +43,7 @@ constexpr size_t kMaxObjBytes = size_t(1) << 30;
 constexpr size_t kMaxObjVertices = size_t(1) << 25;
 constexpr size_t kMaxObjTriangles = size_t(1) << 25;
 // tinyobjloader stores a face's vertex count in one byte: larger faces are refused, not
-// silently cut (issue 10's fuzzing found a 300-vertex face becoming 42 wrong triangles).
+// silently cut (a 300-vertex face would become 42 wrong triangles).
 constexpr size_t kMaxFaceVertices = 255;
 
 struct ObjLimits {

@@ -39,8 +39,8 @@ struct Call {
 };
 
 // Spins for about a millisecond, then sleeps, until `value` is no longer `old`: a repeated
-// trace or the next frame starts within microseconds, and waking a sleeping thread costs
-// 0.1-0.4 ms on this VM (a few percent of a two-thread pass over 250,000 rays).
+// trace or the next frame starts within microseconds, and waking a sleeping thread costs a
+// noticeable share of a short parallel pass.
 template <typename T>
 T awaitChange(const std::atomic<T>& value, T old) {
     auto until = std::chrono::steady_clock::now() + std::chrono::milliseconds(1);

@@ -1,10 +1,9 @@
 // Work on several threads: the calling thread and worker threads kept from one call to the
 // next. Every step's renderer (parallelRows) and step 04's batch tracer run on it.
 //
-// Why kept workers, and why the caller works too: on this 2-core VM, two threads started
-// per call while the caller waited in join() traced short batches no faster than one
-// (0.99-1.05x, step 04's README, "Kept worker threads"); the caller working beside one
-// new thread reached 1.69x, beside a kept worker 1.75x.
+// Why kept workers, and why the caller works too: starting threads for every call costs
+// about as much as a short batch of rays takes, and a caller that only waits in join()
+// leaves a core idle; so the caller works beside workers that wait for the next call.
 #pragma once
 
 #include <functional>

@@ -120,7 +120,7 @@ bool Renderer::needsShadowRay(int light, const SurfaceHit& hit) const {
     for (int object : analysis_.occluders[size_t(light)]) {
         if (object == hit.object) {
             // A convex object cannot shadow a point of its outside; seen from inside (the
-            // camera in a sphere) it blocks every light beyond it (issue 10, hard case).
+            // camera in a sphere) it blocks every light beyond it.
             bool inside = glm::dot(hit.geometricNormal, lightPos - hit.point) < 0.0f &&
                           !analysis_.isPlane[size_t(object)];
             if (!analysis_.convex[size_t(object)] || inside) return true;

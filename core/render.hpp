@@ -1,6 +1,7 @@
 // A Whitted-style ray tracer: direct light with shadow rays, mirror reflection, glass
 // with Fresnel and total internal reflection, up to a maximum depth. It simulates only
-// the effects the scene calls for (WORKBOOK.md, promise 3) and counts every ray it traces.
+// the effects the scene calls for (the image is the same as with every effect traced) and
+// counts every ray it traces.
 #pragma once
 
 #include <atomic>

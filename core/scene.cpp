@@ -67,7 +67,7 @@ void Scene::checkRenderable() const {
             throw std::logic_error("scene '" + name + "' uses a material that does not exist");
     };
     // NaN or infinite geometry or lights would make NaN pixels (or trap): refuse them
-    // with a message naming the object (issue 10, hard cases).
+    // with a message naming the object.
     auto bad = [&](const std::string& what, size_t i) {
         return InputError("scene '" + printable(name) + "': " + what + " " + std::to_string(i) +
                           " has a non-finite or invalid value");

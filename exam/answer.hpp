@@ -13,8 +13,8 @@ constexpr double kRelativeTolerance = 1e-3;
 const char* toleranceText();
 bool withinTolerance(double answer, double expected);
 
-// Typed answers are bounded (issue 10's fuzzing: a line of 10^6 parentheses made the
-// reader quadratic and its recursion deep): longer or deeper answers are refused.
+// Typed answers are bounded (a line of 10^6 parentheses would make the reader quadratic
+// and its recursion deep): longer or deeper answers are refused.
 constexpr size_t kMaxAnswerLength = 1000;  // characters
 // Levels of the reader's recursion: a parenthesis, sign, sqrt or ^ inside another takes
 // one or two, so this allows about 100 nested parentheses.

@@ -616,7 +616,7 @@ Question terminology(Rng& rng, Question q) {
     return q;
 }
 
-// WORKBOOK.md, "Exam practice": the worked example with its exact numbers.
+// The worked example of the exam practice, with its exact numbers.
 Question workedExample(Rng&, Question q) {
     Rayd ray({1, 1, 1}, {1, 0, 1});
     SphereT<double> s{{-1, 1, -1}, std::sqrt(20.0)};

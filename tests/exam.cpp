@@ -1,5 +1,5 @@
 // Exam questions with their exact numbers, answered by the core's routines and checked
-// against values worked out by hand (WORKBOOK.md, "Exam practice").
+// against values worked out by hand.
 #include <cmath>
 
 #include "core/camera.hpp"

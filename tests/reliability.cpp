@@ -1,4 +1,4 @@
-// Reliability hard cases (issue 10): bounded inputs, one-line messages, and a renderer that
+// Reliability hard cases: bounded inputs, one-line messages, and a renderer that
 // survives NaN or infinite scenes, zero-area and identical triangles, and a camera inside an
 // object, each with a clear error or a correct image. The OBJ and message cases were found
 // by the fuzz targets in fuzz/ (their inputs are in fuzz/corpus/).

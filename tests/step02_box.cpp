@@ -5,6 +5,7 @@
 
 #include "02_box/box.hpp"
 #include "02_box/box_scene.hpp"
+#include "02_box/measure.hpp"
 #include "core/render.hpp"
 #include "support.hpp"
 

@@ -153,7 +153,8 @@ void checkVec(const A& actual, const B& expected, double tolerance) {
 }
 
 // Renders a scene once with the renderer's analysis and once with every effect forced on
-// (WORKBOOK.md, promise 3): the images must be identical, the ray counts may differ.
+// (effects on demand must not change the image): the images must be identical, the ray
+// counts may differ.
 struct EffectsComparison {
     RayCounts lean, forced;
     bool identical = false;

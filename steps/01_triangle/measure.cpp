@@ -1,9 +1,11 @@
 #include "01_triangle/measure.hpp"
 
 #include <algorithm>
+#include <iostream>
 #include <map>
 #include <random>
 
+#include "core/render.hpp"
 #include "core/timing.hpp"
 
 namespace boxes {
@@ -201,6 +203,83 @@ Table measureTriangleSpeed(const Mesh& mesh, uint64_t seed, int repeats) {
         run(test, 0.0);
     }
     return table;
+}
+
+Table accuracyVersusTime(const Table& speed, const Table& cracks) {
+    Table t;
+    t.id = "accuracy_vs_time";
+    t.title =
+        "Accuracy against time: each test's speed beside its cracks (all meshes and placements)";
+    t.columns = {"variant", "ns/test", "cracks /1M"};
+    t.note = "ns/test from the speed table; cracks per million over every crack ray";
+    for (size_t i = 0; i < speed.rows.size(); ++i) {
+        const auto& row = speed.rows[i];
+        std::string name = std::get<std::string>(row[0]) + " " + std::get<std::string>(row[1]);
+        double rays = 0.0, missed = 0.0;
+        size_t column = 4 + i;  // cracks columns follow the same order of tests and precisions
+        for (const auto& c : cracks.rows) {
+            double n = double(std::get<long long>(c[3]));
+            rays += n;
+            missed += std::get<double>(c[column]) * n / 1e6;
+        }
+        t.row({name, std::get<double>(row[2]), rays > 0 ? missed / rays * 1e6 : 0.0});
+    }
+    return t;
+}
+
+size_t markDisagreements(const TriangleGrid& grid, const Camera& camera, Image& image,
+                         int threads) {
+    std::vector<size_t> perRow(size_t(image.height()), 0);
+    CameraBasisT<float> basis = camera.basis();
+    parallelRows(image.height(), threads, [&](int y, int) {
+        for (int x = 0; x < image.width(); ++x) {
+            Ray ray(camera.eye, camera.directionThrough(basis, x + 0.5f, y + 0.5f, image.width(),
+                                                        image.height()));
+            uint32_t a = grid.nearestTriangle(ray, TriangleTest::PlaneTest);
+            uint32_t b = grid.nearestTriangle(ray, TriangleTest::MollerTrumbore);
+            uint32_t c = grid.nearestTriangle(ray, TriangleTest::Watertight);
+            if (a != b || b != c) {
+                image.at(x, y) = Vec3(1.0f, 0.0f, 1.0f);
+                ++perRow[size_t(y)];
+            }
+        }
+    });
+    size_t total = 0;
+    for (size_t n : perRow) total += n;
+    return total;
+}
+
+void measureTriangleTests(const StepRun& run, const TriangleGrid& grid, size_t crackRays,
+                          Report& report) {
+    const CommonOptions& o = run.options;
+    const Scene& scene = run.scene;
+    Image marked = run.image;
+    size_t differ = markDisagreements(grid, scene.camera, marked, o.threads);
+    std::string disagreePath = pngWithSuffix(run.png, "-disagree");
+    marked.writePng(disagreePath);
+    report.images.push_back(
+        {disagreePath, "magenta: pixels where the three tests pick different triangles"});
+    report.facts["pixels_disagreeing"] = differ;
+    std::cerr << "01_triangle: measuring speed...\n";
+    report.add(measureTriangleSpeed(scene.mesh, o.seed, 7));
+    std::cerr << "01_triangle: counting cracks...\n";
+    Mesh sh1 = loadObj(o.dataDir + "/meshes/sh1.obj");
+    Mesh bunny = scene.name == "bunny" ? scene.mesh : loadObj(o.dataDir + "/meshes/bunny.obj");
+    Vec3 far(1000.0f, -700.0f, 300.0f);
+    report.add(measureCracks({{"bunny", &bunny, Vec3(0.0f)},
+                              {"bunny", &bunny, far},
+                              {"sh1", &sh1, Vec3(0.0f)},
+                              {"sh1", &sh1, far}},
+                             crackRays, o.seed));
+    report.add(accuracyVersusTime(report.tables[0], report.tables[1]));
+    report.plots.push_back({{"table", "accuracy_vs_time"},
+                            {"x", "ns/test"},
+                            {"y", "cracks /1M"},
+                            {"series", "variant"},
+                            {"logy", true},
+                            {"title",
+                             "Accuracy against time: cracks per million rays "
+                             "aimed at shared edges and vertices"}});
 }
 
 }  // namespace boxes

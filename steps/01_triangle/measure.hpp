@@ -1,5 +1,6 @@
-// Step 01's measurements: time per ray/triangle test, and cracks on shared edges and
-// vertices of closed meshes, for each test in float and in double.
+// Step 01's measurements: time per ray/triangle test, cracks on shared edges and vertices
+// of closed meshes for each test in float and in double, and the pixels where the tests
+// disagree.
 #pragma once
 
 #include <cstdint>
@@ -7,8 +8,10 @@
 #include <vector>
 
 #include "01_triangle/triangle.hpp"
+#include "01_triangle/triangle_grid.hpp"
 #include "core/mesh.hpp"
 #include "core/report.hpp"
+#include "core/step.hpp"
 
 namespace boxes {
 
@@ -43,5 +46,19 @@ Table measureCracks(const std::vector<CrackCase>& cases, size_t raysPerFeature, 
 
 // Median time per test over a fixed mix of hitting and missing ray/triangle pairs.
 Table measureTriangleSpeed(const Mesh& mesh, uint64_t seed, int repeats);
+
+// One row per test and precision: its time per test (from the speed table) beside its
+// cracks over every case (from the cracks table).
+Table accuracyVersusTime(const Table& speed, const Table& cracks);
+
+// Marks in magenta the pixels of the camera's image where the three tests see different
+// nearest triangles; returns their count.
+size_t markDisagreements(const TriangleGrid& grid, const Camera& camera, Image& image, int threads);
+
+// The program's --measure: the disagreement image beside the PNG (FILE-disagree.png), the
+// speed and crack tables (the bunny and sh1, at the origin and far from it), and accuracy
+// against time with its plot.
+void measureTriangleTests(const StepRun& run, const TriangleGrid& grid, size_t crackRays,
+                          Report& report);
 
 }  // namespace boxes

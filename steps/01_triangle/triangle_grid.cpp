@@ -32,8 +32,8 @@ TriangleGrid::TriangleGrid(const Mesh& mesh, int material, TriangleTest test)
     };
     // Bound the cell references: when triangles overlap many cells each (large or many
     // identical triangles), N x cells entries would exhaust memory and overflow the 32-bit
-    // counts (issue 10: 10^5 copies of one triangle asked for about 10^10). Coarsen the
-    // grid until the references fit a budget proportional to N.
+    // counts (10^5 copies of one large triangle would ask for about 10^10). Coarsen the grid
+    // until the references fit a budget proportional to N.
     const size_t budget =
         std::min<size_t>(16 * mesh.triangleCount() + (size_t(1) << 20), UINT32_MAX);
     for (;;) {

@@ -1,5 +1,5 @@
-// Step 02's scene objects (boxes as core Geometry, intersected with either method), its
-// scenes, and its measurements.
+// Step 02's scene objects (boxes as core Geometry, intersected with either method) and its
+// scenes.
 #pragma once
 
 #include <atomic>
@@ -57,28 +57,5 @@ std::vector<SceneBox> boxStepBoxes();
 // Any core scene drawn as boxes: each sphere becomes the cube around it, a mesh its
 // bounding box; planes and lights stay. Returns the boxes (the caller adds the BoxSet).
 std::vector<SceneBox> boxesFromScene(Scene& scene);
-
-// Random rays at random oriented boxes: aimed at face points, at edges, near the box, and
-// a few from inside. Each ray goes with the box it was made for.
-struct BoxRay {
-    Ray ray;
-    uint32_t box;
-};
-struct BoxRaySet {
-    std::vector<OrientedBox> boxes;
-    std::vector<BoxRay> rays;
-};
-BoxRaySet makeBoxRays(size_t boxCount, size_t raysPerBox, uint64_t seed);
-
-// Time per test for both methods in float and double, and each one's wrong answers against
-// the long double slab method (hit or miss, face, t). Tables "box_speed", "box_accuracy".
-std::vector<Table> measureBoxMethods(const BoxRaySet& set, int repeats);
-
-// Six planes against slabs, both in float, ray by ray: hit/miss, face, t. Table row cells.
-struct Disagreement {
-    long long rays = 0, hitMiss = 0, face = 0;
-    double maxRelativeT = 0.0;  // max |t_planes - t_slabs| / |t| where both hit
-};
-Disagreement compareMethods(const BoxRaySet& set);
 
 }  // namespace boxes

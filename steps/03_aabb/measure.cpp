@@ -158,4 +158,33 @@ PretestResult measurePretest(ManyObjects& objects, const Camera& camera,
     return result;
 }
 
+void measureBoundingBoxes(const StepRun& run, ManyObjects& objects, size_t hardRays, int frameWidth,
+                          int frameHeight, Report& report) {
+    std::cerr << "03_aabb: slab tests on hard rays...\n";
+    for (Table& t : measureSlabTests(makeHardSlabRays(hardRays, run.options.seed), 15))
+        report.add(std::move(t));
+    RenderSettings small = run.settings;
+    small.width = frameWidth;
+    small.height = frameHeight;
+    Camera camera = run.scene.camera;
+    camera.aspect = float(frameWidth) / float(frameHeight);
+    PretestResult p = measurePretest(objects, camera, small);
+    report.add(p.table);
+    report.facts["pretest_pixels_differing"] = p.pixelsDiffering;
+    report.plots.push_back({{"table", "slab_accuracy"},
+                            {"x", "ns/test"},
+                            {"y", "wrong /1M"},
+                            {"series", "variant"},
+                            {"logy", true},
+                            {"title", "Slab tests: time per test and wrong answers on hard rays"}});
+    report.plots.push_back(
+        {{"table", "pretest"},
+         {"x", "ms/frame"},
+         {"y", "primitive tests/ray"},
+         {"series", "pre-test"},
+         {"logx", true},
+         {"logy", true},
+         {"title", "A box pre-test: time per frame and primitive tests per ray"}});
+}
+
 }  // namespace boxes

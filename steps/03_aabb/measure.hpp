@@ -8,6 +8,7 @@
 #include "03_aabb/why_we_care.hpp"
 #include "core/render.hpp"
 #include "core/report.hpp"
+#include "core/step.hpp"
 
 namespace boxes {
 
@@ -31,5 +32,11 @@ struct PretestResult {
 };
 PretestResult measurePretest(ManyObjects& objects, const Camera& camera,
                              const RenderSettings& settings);
+
+// The program's --measure: the slab tests on `hardRays` hard rays per category, and the
+// scene's frames with and without the pre-test at `frameWidth` x `frameHeight`, with the
+// plots.
+void measureBoundingBoxes(const StepRun& run, ManyObjects& objects, size_t hardRays, int frameWidth,
+                          int frameHeight, Report& report);
 
 }  // namespace boxes

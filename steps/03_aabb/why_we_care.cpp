@@ -5,6 +5,7 @@
 #include <random>
 
 #include "01_triangle/triangle.hpp"
+#include "core/triangle_hit.hpp"
 
 namespace boxes {
 
@@ -151,22 +152,7 @@ bool TriangleGroups::intersect(const Ray& rayIn, SurfaceHit& hit) const {
     counts_->boxTests.fetch_add(boxTests, std::memory_order_relaxed);
     counts_->primitiveTests.fetch_add(tests, std::memory_order_relaxed);
     if (found == kNoPrimitive) return false;
-    Vec3 a = mesh_.vertex(found, 0), b = mesh_.vertex(found, 1), c = mesh_.vertex(found, 2);
-    hit.t = ray.tmax;
-    hit.point = ray.at(hit.t);
-    hit.geometricNormal = glm::normalize(glm::cross(b - a, c - a));
-    hit.shadingNormal = hit.geometricNormal;
-    if (mesh_.normals.size() == mesh_.positions.size()) {
-        const auto& idx = mesh_.triangles[found];
-        Vec3 n = (1.0f - u - v) * mesh_.normals[idx[0]] + u * mesh_.normals[idx[1]] +
-                 v * mesh_.normals[idx[2]];
-        if (glm::length(n) > 0.0f) hit.shadingNormal = glm::normalize(n);
-    }
-    hit.u = u;
-    hit.v = v;
-    hit.material = material_;
-    hit.primitive = found;
-    hit.kind = SurfaceHit::Kind::Triangle;
+    hit = triangleHit(mesh_, found, ray, ray.tmax, u, v, material_);
     return true;
 }
 

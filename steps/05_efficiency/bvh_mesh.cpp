@@ -3,6 +3,7 @@
 #include <algorithm>
 
 #include "04_bvh/advanced/build.hpp"
+#include "core/triangle_hit.hpp"
 
 namespace boxes {
 
@@ -119,23 +120,7 @@ bool LabBvhMesh::intersect(const Ray& ray, SurfaceHit& hit) const {
     long slot = nearest(ray, best);
     if (slot < 0) return false;
     uint32_t t = bvh_.primitiveIndices[size_t(slot)];
-    hit.t = best.t;
-    hit.point = ray.at(best.t);
-    hit.geometricNormal = glm::normalize(precomputed_[size_t(slot)].normal);
-    const auto& idx = mesh_.triangles[t];
-    if (mesh_.normals.size() == mesh_.positions.size()) {
-        Vec3 n = (1.0f - best.u - best.v) * mesh_.normals[idx[0]] + best.u * mesh_.normals[idx[1]] +
-                 best.v * mesh_.normals[idx[2]];
-        float len = glm::length(n);
-        hit.shadingNormal = len > 0.0f && std::isfinite(len) ? n / len : hit.geometricNormal;
-    } else {
-        hit.shadingNormal = hit.geometricNormal;
-    }
-    hit.u = best.u;
-    hit.v = best.v;
-    hit.material = material_;
-    hit.primitive = t;
-    hit.kind = SurfaceHit::Kind::Triangle;
+    hit = triangleHit(mesh_, t, ray, best.t, best.u, best.v, material_);
     return true;
 }
 

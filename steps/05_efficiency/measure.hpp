@@ -1,5 +1,6 @@
 // Step 05's lab: every trade-off of the optimization primer measured side by side, as
-// time against error (each function returns one table of the report).
+// time against error. Each function returns one table of the report and lives in its own
+// file under experiments/.
 #pragma once
 
 #include <cstdint>
@@ -9,6 +10,7 @@
 #include "core/render.hpp"
 #include "core/report.hpp"
 #include "core/scene.hpp"
+#include "core/step.hpp"
 
 namespace boxes {
 
@@ -35,6 +37,16 @@ Table measureInverseSqrt(const LabOptions& o);
 Table measureThreads(const Scene& scene, const LabOptions& o);
 Table measureAntiAliasing(const Scene& scene, const LabOptions& o);
 Table measurePreviews(const Scene& scene, const LabOptions& o);
+Table measureTotalSpeedup(const Scene& scene, const LabOptions& o);  // all together
+
+// The program's --measure: every table above in the primer's order, the mesh tables on
+// `mesh` (the bunny when it is null), with their plots and the total speed-up as a fact.
+void measureLab(const Scene& scene, LabBvhMesh* mesh, const LabOptions& o, Report& report);
+
+// The headless run's other images: every preview mode beside the PNG (FILE-depth.png, ...),
+// and the image refined line by line in frames of budgetMs, which must be bit-identical to
+// run.image (else std::runtime_error).
+void writePreviews(const StepRun& run, double budgetMs, Report& report);
 
 // Times each function `repeats` times, one call of each per round (round-robin), so a
 // drift in the machine's load is shared by all of them. One Timing per function.

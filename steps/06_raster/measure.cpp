@@ -1,6 +1,7 @@
 #include "06_raster/measure.hpp"
 
 #include <cstdio>
+#include <cstdlib>
 #include <filesystem>
 #include <iostream>
 
@@ -33,17 +34,13 @@ void attachGrid(Scene& scene) {
         scene.geometries.push_back(std::make_shared<TriangleGrid>(scene.mesh, scene.meshMaterial));
 }
 
-std::string findSharedMeshes(const std::string& dataDir) {
-    namespace fs = std::filesystem;
-    for (fs::path candidate :
-         {fs::path(dataDir) / ".." / ".." / "shared" / "data" / "meshes",
-          fs::path(dataDir) / ".." / ".." / ".." / "shared" / "data" / "meshes",
-          fs::path("..") / "shared" / "data" / "meshes"}) {
-        std::error_code ec;
-        if (fs::exists(candidate / "oa_thor.obj", ec))
-            return fs::weakly_canonical(candidate, ec).string();
-    }
-    return "";
+std::string findSharedMeshes() {
+    const char* env = std::getenv("BOXES_MESHES");
+    if (!env || !*env) return "";
+    std::error_code ec;
+    if (!std::filesystem::exists(std::filesystem::path(env) / "oa_thor.obj", ec))
+        throw InputError("BOXES_MESHES=" + printable(env) + ": no oa_thor.obj in that folder");
+    return std::filesystem::weakly_canonical(env, ec).string();
 }
 
 std::vector<MeasureView> measureViews(const std::string& dataDir, const std::string& sharedMeshes,
@@ -347,6 +344,74 @@ Table measureInterpolation(const MeasureView& bunny, const MeasureSettings& m,
         }
     }
     return t;
+}
+
+void compareWithRayTracer(const StepRun& run, const RasterView& view, const RasterFrame& frame,
+                          Report& report) {
+    const Scene& scene = run.scene;
+    const int w = view.raster.width, h = view.raster.height;
+    const std::vector<uint32_t> ids = meshIds(view.scene, frame.buffers);
+    TracedFrame traced = traceFrame(scene, scene.camera, w, h, true, 1);
+    VisibilityComparison c = compareVisibility(w, h, ids, meshDepths(view.scene, frame.buffers),
+                                               traced.ids, traced.depth, &scene.mesh);
+    std::string diff = pngWithSuffix(run.png, "-diff");
+    differenceImage(w, h, ids, traced.ids).writePng(diff);
+    report.images.push_back({diff,
+                             "grey: same triangle; red: only the rasterizer; blue: only "
+                             "the ray tracer; yellow: different triangles"});
+    ShadowComparison sc =
+        compareShadows(ids, frame.shaded.litByFirstLight, traced.ids, traced.litByFirstLight);
+    const double rasterMs = frame.stats.milliseconds, shadeMs = frame.shaded.milliseconds;
+    report.facts["compare"] = {{"pixels_covered_raster", c.coveredRaster},
+                               {"pixels_covered_traced", c.coveredTraced},
+                               {"same_triangle_share", c.agreement()},
+                               {"differ_on_edges", c.differOnEdge},
+                               {"differ_elsewhere", c.differElsewhere},
+                               {"coverage_difference_share", c.coverageDifference()},
+                               {"max_depth_error", c.maxDepthError},
+                               {"mean_depth_error", c.meanDepthError},
+                               {"shadow_pixels_disagreeing", sc.acne + sc.leaks},
+                               {"shadow_pixels_compared", sc.compared},
+                               {"raster_frame_ms", rasterMs + shadeMs},
+                               {"traced_frame_ms", traced.milliseconds}};
+    std::printf("pixels covered: raster %zu, ray tracer %zu (difference %.4f%% of the image)\n",
+                c.coveredRaster, c.coveredTraced, 100.0 * c.coverageDifference());
+    std::printf(
+        "same triangle: %.4f%% of covered pixels (%zu differ on triangle edges, %zu "
+        "elsewhere)\n",
+        100.0 * c.agreement(), c.differOnEdge, c.differElsewhere);
+    std::printf("depth error where they agree: max %.3g, mean %.3g (relative)\n", c.maxDepthError,
+                c.meanDepthError);
+    std::printf("shadows (%s) against the ray tracer's: %zu of %zu pixels disagree\n",
+                shadowModeName(view.shading.shadows), sc.acne + sc.leaks, sc.compared);
+    std::printf(
+        "time per frame, single thread: raster %.1f ms (+ shading %.1f ms), ray tracer "
+        "%.1f ms "
+        "(visibility and shadow rays)\n",
+        rasterMs, shadeMs, traced.milliseconds);
+}
+
+void measureRaster(const StepRun& run, Report& report) {
+    MeasureSettings ms;
+    ms.width = run.options.width;
+    ms.height = run.options.height;
+    const CommonOptions& o = run.options;
+    std::vector<MeasureView> views = measureViews(o.dataDir, findSharedMeshes(), o.aspect());
+    report.add(measureVisibility(views, ms));
+    report.add(measureFrameTimes(views, ms));
+    report.add(measureCulling(views, ms));
+    std::cerr << "06_raster: shadows...\n";
+    report.add(measureShadowBias(views[0], ms));
+    report.add(measureShadowMethods(views[0], ms));
+    std::cerr << "06_raster: interpolation...\n";
+    report.add(measureInterpolation(views[0], ms, pngStem(run.png), report.images));
+    report.plots.push_back(
+        {{"table", "shadow_bias"},
+         {"x", "bias (x diagonal)"},
+         {"y", "disagree %"},
+         {"series", "map size"},
+         {"logx", true},
+         {"title", "Shadow map bias: acne at small bias, peter-panning at large"}});
 }
 
 }  // namespace boxes

@@ -1,7 +1,7 @@
-// Step 06's measurements: primary visibility and time per frame of the rasterizer against
-// the ray tracer on a few views, the shadow map's bias against acne and peter-panning,
-// the two shadow methods against the ray tracer's shadows, and affine against
-// perspective-correct interpolation.
+// Step 06's measurements: the program's frame against the ray tracer (--compare); primary
+// visibility and time per frame of the rasterizer against the ray tracer on a few views,
+// the shadow map's bias against acne and peter-panning, the two shadow methods against the
+// ray tracer's shadows, and affine against perspective-correct interpolation (--measure).
 #pragma once
 
 #include <algorithm>
@@ -10,7 +10,9 @@
 #include <vector>
 
 #include "06_raster/compare.hpp"
+#include "06_raster/frame.hpp"
 #include "core/report.hpp"
+#include "core/step.hpp"
 
 namespace boxes {
 
@@ -24,14 +26,15 @@ struct MeasureView {
 // The scene with step 01's TriangleGrid as the mesh's geometry (the ray tracer's view of it).
 void attachGrid(Scene& scene);
 
-// The built-in views: the bunny from outside, the bunny seen from inside itself, and
-// oa_thor from inside when `sharedMeshes` (../shared/data/meshes) holds it.
+// The built-in views: the bunny and sh1 from outside, and oa_thor from inside when
+// `sharedMeshes` (a folder, see findSharedMeshes) is not empty.
 std::vector<MeasureView> measureViews(const std::string& dataDir, const std::string& sharedMeshes,
                                       float aspect);
 
-// Where ../shared/data/meshes is, relative to the source tree or the working directory;
-// empty when it is not there.
-std::string findSharedMeshes(const std::string& dataDir);
+// The folder of the larger meshes that the workbook does not ship (oa_thor.obj), named by
+// the environment variable BOXES_MESHES; empty when it is not set. Throws InputError when
+// it is set but holds no oa_thor.obj.
+std::string findSharedMeshes();
 
 struct MeasureSettings {
     int width = 640, height = 480;
@@ -56,5 +59,13 @@ Table measureCulling(const std::vector<MeasureView>& views, const MeasureSetting
 Table measureInterpolation(const MeasureView& bunny, const MeasureSettings& settings,
                            const std::string& pngStem,
                            std::vector<std::pair<std::string, std::string>>& images);
+
+// The program's --compare: the frame's ids, depths and shadows against the ray tracer's of
+// the same view (a "compare" fact, the difference image FILE-diff.png, lines on stdout).
+void compareWithRayTracer(const StepRun& run, const RasterView& view, const RasterFrame& frame,
+                          Report& report);
+
+// The program's --measure: every table above at the image's size, with the bias plot.
+void measureRaster(const StepRun& run, Report& report);
 
 }  // namespace boxes

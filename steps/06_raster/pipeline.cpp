@@ -7,6 +7,7 @@
 #include "core/mesh.hpp"
 #include "core/render.hpp"
 #include "core/timing.hpp"
+#include "core/triangle_hit.hpp"
 
 namespace boxes {
 
@@ -314,23 +315,12 @@ bool surfaceAt(const RasterScene& scene, const FrameBuffers& buffers, int x, int
     size_t i = buffers.index(x, y);
     uint32_t id = buffers.triangle[i];
     if (id == kNoPrimitive) return false;
-    const auto& tri = scene.triangles[id];
-    float w1 = buffers.weight1[i], w2 = buffers.weight2[i], w0 = 1.0f - w1 - w2;
-    Vec3 a = scene.positions[tri[0]], b = scene.positions[tri[1]], c = scene.positions[tri[2]];
-    hit.point = w0 * a + w1 * b + w2 * c;
-    Vec3 n = glm::cross(b - a, c - a);
-    float length = glm::length(n);
-    hit.geometricNormal = length > 0.0f ? n / length : Vec3(0, 1, 0);
-    Vec3 s = w0 * scene.normals[tri[0]] + w1 * scene.normals[tri[1]] + w2 * scene.normals[tri[2]];
-    float sLength = glm::length(s);
-    hit.shadingNormal = sLength > 0.0f ? s / sLength : hit.geometricNormal;
-    hit.u = w1;
-    hit.v = w2;
+    hit = triangleSurface(scene.positions, scene.normals, scene.triangles[id], buffers.weight1[i],
+                          buffers.weight2[i]);
     hit.t = buffers.depth[i];
     hit.material = scene.material[id];
     hit.object = scene.object[id];
     hit.primitive = id;
-    hit.kind = SurfaceHit::Kind::Triangle;
     return true;
 }
 

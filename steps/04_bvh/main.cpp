@@ -5,14 +5,14 @@
 #include <imgui.h>
 
 #include <algorithm>
+#include <memory>
 
 #include "04_bvh/advanced/build.hpp"
 #include "04_bvh/advanced/commands.hpp"
 #include "04_bvh/culling_map.hpp"
 #include "04_bvh/measure.hpp"
-#include "core/app.hpp"
-#include "core/orbit.hpp"
-#include "core/timing.hpp"
+#include "core/render.hpp"
+#include "core/step.hpp"
 
 using namespace boxes;
 
@@ -29,92 +29,77 @@ static std::shared_ptr<MeshBvhGeometry> meshGeometry(Scene& scene, const BvhBuil
 }
 
 int main(int argc, char** argv) {
-    return runMain("04_bvh", [&] {
-        CLI::App app{
-            "Step 04: bounding volume hierarchies: builders, traversal, frustum culling, "
-            "and a trace command for ray files."};
-        CommonOptions opts;
-        addCommonOptions(app, opts, "bunny");
-        std::string builderName = "sah";
+    std::string builderName = "sah";
+    MeasureSettings measure;
+    std::unique_ptr<EngineCommands> commands;  // trace and check, on the same command line
+    BvhBuildOptions build;
+    std::shared_ptr<MeshBvhGeometry> geometry;  // none for a scene without a mesh
+
+    StepProgram step;
+    step.name = "04_bvh";
+    step.description =
+        "Step 04: bounding volume hierarchies: builders, traversal, frustum culling, and a "
+        "trace command for ray files.";
+    step.title = "Step 04: bounding volume hierarchies";
+    step.defaultScene = "bunny";
+    step.addOptions = [&](CLI::App& app) {
         app.add_option("--builder", builderName,
                        "hierarchy builder: midpoint, median, sah, sweep-sah, sbvh")
             ->capture_default_str();
-        MeasureSettings measure;
         app.add_option("--bins", measure.bins, "binned SAH: bins per axis")
             ->check(CLI::Range(2, 256))
             ->capture_default_str();
         addMeasureOptions(app, measure);
-        EngineCommands commands(app);
-        parseCommandLine(app, argc, argv);
-        if (std::optional<int> code = commands.run()) return *code;
-
-        BvhBuildOptions build;
+        commands = std::make_unique<EngineCommands>(app);
+    };
+    step.command = [&] { return commands->run(); };
+    step.addGeometry = [&](StepRun& run) {
         build.builder = parseBvhBuilder(builderName);
         build.bins = measure.bins;
-        Scene scene = sceneFromOptions(opts);
-        std::shared_ptr<MeshBvhGeometry> geometry = meshGeometry(scene, build);
-        RenderSettings settings = opts.renderSettings();
-        if (opts.headless) {
-            Report report;
-            report.program = "04_bvh";
-            std::string out = headlessPath(opts, report.program);
-            renderHeadlessImage(scene, scene.camera, settings, out,
-                                "scene '" + scene.name + "' through the " +
-                                    bvhBuilderName(build.builder) + " hierarchy",
-                                report);
-            if (geometry) addTreeReport(report, scene, *geometry, out, opts, measure);
-            writeReport(report, opts);
-            return 0;
-        }
+        geometry = meshGeometry(run.scene, build);
+    };
+    step.caption = [&](const StepRun& run) {
+        return "scene '" + run.scene.name + "' through the " + bvhBuilderName(build.builder) +
+               " hierarchy";
+    };
+    step.measure = [&](StepRun& run, Report& report) {
+        if (geometry) addTreeReport(report, run.scene, *geometry, run.png, run.options, measure);
+    };
 
-        // The window: left the view through the hierarchy, right the hierarchy from above.
-        settings.width = std::max(1, opts.width / 2);
-        Camera start = scene.camera;
-        start.aspect = float(settings.width) / float(settings.height);
-        OrbitController orbit(start);
-        CullingMapWindow map;
-        bool dirty = true;
-        Image image(opts.width, opts.height);
-        double renderMs = 0.0;
-        WindowCallbacks cb;
-        cb.keys = {
-            {SDLK_b, "next builder (midpoint / median / binned SAH / spatial splits), rebuilds"}};
-        for (const KeyBinding& k : CullingMapWindow::keys()) cb.keys.push_back(k);
-        cb.onKey = [&](int key) {
-            constexpr BvhBuilder cycle[] = {BvhBuilder::Midpoint, BvhBuilder::Median,
-                                            BvhBuilder::BinnedSah, BvhBuilder::SpatialSah};
-            if (key == SDLK_b && geometry) {
-                const BvhBuilder* at = std::find(std::begin(cycle), std::end(cycle), build.builder);
-                build.builder =
-                    at == std::end(cycle) || at + 1 == std::end(cycle) ? cycle[0] : at[1];
-                geometry = meshGeometry(scene, build);
-                return dirty = true;
-            }
-            if (!map.onKey(key)) return false;
-            return dirty = true;
-        };
-        orbit.addTo(cb, [&] { dirty = true; });
-        cb.frame = [&](double) -> const Image& {
-            if (!dirty) return image;
-            Stopwatch watch;
-            Image view = renderImage(scene, orbit.camera(), settings);
-            renderMs = watch.milliseconds();
-            for (int y = 0; y < view.height(); ++y)
-                for (int x = 0; x < view.width(); ++x) image.at(x, y) = view.at(x, y);
-            if (geometry)
-                map.draw(image, settings.width, geometry->bvh(), orbit.camera(), scene.camera.up);
-            dirty = false;
-            return image;
-        };
-        cb.panel = [&] {
-            ImGui::Text("builder: %s  render: %.1f ms", bvhBuilderName(build.builder), renderMs);
-            if (!geometry) return;
-            const BvhBuildStats& s = geometry->stats();
-            ImGui::Text("build %.1f ms, %zu nodes, depth %d, SAH cost %.1f", s.buildMs, s.nodes,
-                        s.depth, s.sahCost);
-            for (const std::string& line : map.status()) ImGui::TextUnformatted(line.c_str());
-        };
-        runWindow(opts.windowOptions("Step 04: bounding volume hierarchies"), cb);
-        return 0;
-    });
+    // The window: left the view through the hierarchy, right the hierarchy from above.
+    CullingMapWindow map;
+    step.keys = {
+        {SDLK_b, "next builder (midpoint / median / binned SAH / spatial splits), rebuilds"}};
+    for (const KeyBinding& k : CullingMapWindow::keys()) step.keys.push_back(k);
+    step.openWindow = [&](StepRun& run) {
+        run.settings.width = std::max(1, run.options.width / 2);
+        run.scene.camera.aspect = float(run.settings.width) / float(run.settings.height);
+    };
+    step.onKey = [&](StepRun& run, int key) {
+        constexpr BvhBuilder cycle[] = {BvhBuilder::Midpoint, BvhBuilder::Median,
+                                        BvhBuilder::BinnedSah, BvhBuilder::SpatialSah};
+        if (key != SDLK_b || !geometry) return map.onKey(key);
+        const BvhBuilder* at = std::find(std::begin(cycle), std::end(cycle), build.builder);
+        build.builder = at == std::end(cycle) || at + 1 == std::end(cycle) ? cycle[0] : at[1];
+        geometry = meshGeometry(run.scene, build);
+        return true;
+    };
+    step.render = [&](StepRun& run) {
+        Image view = renderImage(run.scene, run.camera, run.settings);
+        Image image(run.options.width, run.options.height);
+        for (int y = 0; y < view.height(); ++y)
+            for (int x = 0; x < view.width(); ++x) image.at(x, y) = view.at(x, y);
+        if (geometry)
+            map.draw(image, run.settings.width, geometry->bvh(), run.camera, run.scene.camera.up);
+        return image;
+    };
+    step.panel = [&](StepRun& run) {
+        ImGui::Text("builder: %s  render: %.1f ms", bvhBuilderName(build.builder), run.renderMs);
+        if (!geometry) return;
+        const BvhBuildStats& s = geometry->stats();
+        ImGui::Text("build %.1f ms, %zu nodes, depth %d, SAH cost %.1f", s.buildMs, s.nodes,
+                    s.depth, s.sahCost);
+        for (const std::string& line : map.status()) ImGui::TextUnformatted(line.c_str());
+    };
+    return runStep(argc, argv, step);
 }

@@ -276,6 +276,90 @@ TEST_SUITE("exercise 1.5") {
     }
 }
 
+// Exercise 1.5's hard cases that take float out of its range (found by fuzzing step 04's
+// copy of the test): the fallback to double decides them.
+TEST_SUITE("exercise 1.5") {
+    TEST_CASE("hard case: a triangle 1e21 across straight ahead is hit") {
+        // Its float edge functions overflow (products near 1e42, inf - inf = NaN): without
+        // the fallback to double the ray passes through it.
+        test::FpTrapsOff overflowOnPurpose;
+        const Triangle big{
+            {-1e21f, -1e21f, -5e20f}, {1e21f, -1e21f, -5e20f}, {0.0f, 1e21f, -5e20f}};
+        auto h = intersectWatertight(Ray(Vec3(0.0f), Vec3(0.0f, 0.0f, -1.0f)), big);
+        REQUIRE(h.has_value());
+        // Worked by hand: (0, 0) = (1 - u - v) a + u b + v c gives v = 1/2, u = 1/4.
+        CHECK(double(h->t) == doctest::Approx(5e20).epsilon(1e-6));
+        CHECK(double(h->u) == doctest::Approx(0.25).epsilon(1e-6));
+        CHECK(double(h->v) == doctest::Approx(0.5).epsilon(1e-6));
+        // Beside it and behind the ray: misses, also in double.
+        CHECK_FALSE(
+            intersectWatertight(Ray(Vec3(3e21f, 0.0f, 0.0f), Vec3(0.0f, 0.0f, -1.0f)), big));
+        CHECK_FALSE(intersectWatertight(Ray(Vec3(0.0f), Vec3(0.0f, 0.0f, 1.0f)), big));
+        auto d = intersectWatertight(Rayd(Vec3d(0.0), Vec3d(0.0, 0.0, -1.0)),
+                                     Triangled{Vec3d(big.a), Vec3d(big.b), Vec3d(big.c)});
+        REQUIRE(d.has_value());
+        CHECK(d->t == doctest::Approx(double(5e20f)).epsilon(1e-12));  // the float plane, widened
+    }
+    TEST_CASE("hard case: a tiny triangle behind a ray with a 1e28 direction is missed (t = -0)") {
+        // With |D| = 1e28 the scaled depths are about 1e-27 and the edge functions of a
+        // triangle 1e-15 across about 1e-30: their float products underflow to zero, t
+        // comes out -0, and -0 >= tmin = 0 accepts a triangle that lies behind the ray.
+        const Triangle tiny{
+            {-1e-15f, -1e-15f, 3.0f}, {1e-15f, -1e-15f, 3.0f}, {0.0f, 1e-15f, 3.0f}};
+        CHECK_FALSE(
+            intersectWatertight(Ray(Vec3(0.0f, 0.0f, -5.0f), Vec3(0.0f, 0.0f, -1e28f)), tiny));
+        // The fuzzer's own input: a triangle without area whose line crosses the ray.
+        const Triangle flat{{0.0f, 0.0f, 3.0f}, {1.0f, 1.0f, 3.0f}, {2.0f, 2.0f, 3.0f}};
+        CHECK_FALSE(intersectWatertight(
+            Ray(Vec3(1.0f, 1.0f, -5.0f), Vec3(0.0f, 8.149072e-10f, -1.0603488e28f)), flat));
+        // Towards it the same triangle is hit, at 8 / 1e28.
+        auto ahead =
+            intersectWatertight(Ray(Vec3(0.0f, 0.0f, -5.0f), Vec3(0.0f, 0.0f, 1e28f)), tiny);
+        REQUIRE(ahead.has_value());
+        CHECK(double(ahead->t) == doctest::Approx(8e-28).epsilon(1e-5));
+    }
+    TEST_CASE("hard case: a triangle 3e38 away is hit at a finite t or missed (t = +inf)") {
+        // The scaled depth 3e38 times an edge function of about 4 overflows: t came out
+        // +inf, and t <= tmax = inf took it for a hit, even with tmin beyond the true t.
+        test::FpTrapsOff overflowOnPurpose;
+        const Triangle tri{{-1.0f, -1.0f, -1.0f}, {1.0f, -1.0f, -1.0f}, {0.0f, 1.0f, -1.0f}};
+        const float far = 3e38f;
+        auto h = intersectWatertight(Ray(Vec3(0.0f, 0.0f, far), Vec3(0.0f, 0.0f, -1.0f)), tri);
+        REQUIRE(h.has_value());
+        CHECK(h->t == far);  // far + 1 rounds to far
+        CHECK(std::isfinite(h->u));
+        // tmin just beyond the hit; and a ray of speed 1/2, whose t = 6e38 has no float.
+        CHECK_FALSE(intersectWatertight(
+            Ray(Vec3(0.0f, 0.0f, far), Vec3(0.0f, 0.0f, -1.0f), nextFloatUp(far)), tri));
+        CHECK_FALSE(intersectWatertight(Ray(Vec3(0.0f, 0.0f, far), Vec3(0.0f, 0.0f, -0.5f)), tri));
+    }
+    TEST_CASE(
+        "hard case: an edge function that rounds to zero on a shared edge is recomputed in "
+        "double so exactly one neighbour hits") {
+        // Along +z from the origin the sheared vertices are the vertices' (x, y). The shared
+        // edge runs from b = (1, 1 + e) to c = -(1 + e, 1 + 2e), e = 2^-23, past the origin:
+        // its edge function cx by - cy bx is -(1 + e)^2 + (1 + 2e) = -e^2 exactly, but both
+        // products round to the float 1 + 2e, so in float it is 0 in both triangles, and
+        // both would report the ray. The products are exact in double: -e^2 for one
+        // triangle, +e^2 for the other, so the ray is in exactly one of them.
+        const float e = std::ldexp(1.0f, -23);
+        const Vec3 b(1.0f, 1.0f + e, 1.0f), c(-(1.0f + e), -(1.0f + 2.0f * e), 1.0f);
+        REQUIRE(c.x * b.y - c.y * b.x == 0.0f);  // the float edge function is exactly 0
+        const Triangle upperLeft{{-1.0f, 1.0f, 1.0f}, b, c};   // exact: u < 0 < v, w
+        const Triangle lowerRight{{1.0f, -1.0f, 1.0f}, c, b};  // exact: u, v, w > 0
+        const Ray ray(Vec3(0.0f), Vec3(0.0f, 0.0f, 1.0f));
+        auto hitUpper = intersectWatertight(ray, upperLeft);
+        auto hitLower = intersectWatertight(ray, lowerRight);
+        CHECK_FALSE(hitUpper.has_value());
+        REQUIRE(hitLower.has_value());
+        CHECK(hitLower->t == 1.0f);
+        // The origin lies on the edge c-b (u = 0 of the lower triangle's a), halfway along
+        // within rounding: weights of c and b about 1/2 each.
+        CHECK(double(hitLower->u) == doctest::Approx(0.5).epsilon(1e-6));
+        CHECK(double(hitLower->v) == doctest::Approx(0.5).epsilon(1e-6));
+    }
+}
+
 TEST_SUITE("exercise 1.6") {
     TEST_CASE("normal interpolation: worked values") {
         Vec3 x(1, 0, 0), y(0, 1, 0), z(0, 0, 1);

@@ -1,5 +1,9 @@
 #include "01_triangle/triangle.hpp"
 
+#include <cmath>
+#include <limits>
+#include <type_traits>
+
 #include "core/exercise.hpp"
 
 namespace boxes {
@@ -90,24 +94,47 @@ std::optional<TriangleHit<T>> intersectWatertight(const RayT<T>& ray, const Tria
     T u = cx * by - cy * bx;
     T v = ax * cy - ay * cx;
     T w = bx * ay - by * ax;
-    // An edge function that rounds to exactly zero is recomputed in double, so that
-    // neighbouring triangles agree on which side of the shared edge the ray passes.
-    if constexpr (std::is_same_v<T, float>) {
+    constexpr bool inFloat = std::is_same_v<T, float>;
+    if constexpr (inFloat) {
+        // An edge function that rounds to exactly zero is recomputed in double (the
+        // products of two floats are exact there), so that neighbouring triangles agree
+        // on which side of the shared edge the ray passes.
         if (u == 0.0f || v == 0.0f || w == 0.0f) {
             u = T(double(cx) * double(by) - double(cy) * double(bx));
             v = T(double(ax) * double(cy) - double(ay) * double(cx));
             w = T(double(bx) * double(ay) - double(by) * double(ax));
         }
     }
+    T det = u + v + w;
+    // Far from the ray origin the float products overflow (a triangle 1e21 across: inf -
+    // inf = NaN), and the test would miss what it should hit: decide it in double.
+    if constexpr (inFloat)
+        if (!std::isfinite(det)) return intersectWatertightInDouble(ray, tri);
     if ((u < T(0) || v < T(0) || w < T(0)) && (u > T(0) || v > T(0) || w > T(0)))
         return std::nullopt;
-    T det = u + v + w;
     if (det == T(0) || !std::isfinite(det)) return std::nullopt;
     T az = sz * a[kz], bz = sz * b[kz], cz = sz * c[kz];
-    T t = (u * az + v * bz + w * cz) / det;
-    if (!(t >= ray.tmin && t <= ray.tmax)) return std::nullopt;
+    T tScaled = u * az + v * bz + w * cz;
+    // Outside float's normal range the products underflow to zeros of either sign (t = -0,
+    // a hit at tmin = 0, for a tiny triangle behind a ray with |D| = 1e28) or overflow
+    // (t = inf for a triangle 3e38 away): decide those in double too.
+    if constexpr (inFloat) {
+        T magnitude = std::fabs(tScaled);
+        if (!(magnitude >= std::numeric_limits<T>::min() &&
+              magnitude <= std::numeric_limits<T>::max()))
+            return intersectWatertightInDouble(ray, tri);
+    }
+    T t = tScaled / det;
+    if (!(t >= ray.tmin && t <= ray.tmax && std::isfinite(t))) return std::nullopt;
     return TriangleHit<T>{t, v / det, w / det};
     // END SOLUTION
+}
+
+std::optional<TriangleHit<float>> intersectWatertightInDouble(const Ray& ray, const Triangle& tri) {
+    auto h =
+        intersectWatertight(ray.as<double>(), Triangled{Vec3d(tri.a), Vec3d(tri.b), Vec3d(tri.c)});
+    if (!h || !(std::fabs(float(h->t)) <= std::numeric_limits<float>::max())) return std::nullopt;
+    return TriangleHit<float>{float(h->t), float(h->u), float(h->v)};
 }
 
 // EXERCISE 1.6: interpolate the vertex normals with the barycentrics, normalized (1 point)

@@ -54,9 +54,14 @@ std::optional<TriangleHit<T>> intersectPlaneTest(const RayT<T>& ray, const Trian
 template <typename T>
 std::optional<TriangleHit<T>> intersectMollerTrumbore(const RayT<T>& ray, const TriangleT<T>& tri);
 
-// Exercise 1.5: the watertight test of Woop, Benthin and Wald (JCGT 2013).
+// Exercise 1.5: the watertight test of Woop, Benthin and Wald (JCGT 2013). In float it
+// hands the triangles whose arithmetic leaves float's range to the fallback below.
 template <typename T>
 std::optional<TriangleHit<T>> intersectWatertight(const RayT<T>& ray, const TriangleT<T>& tri);
+
+// Exercise 1.5's fallback (given): the same test in double, its hit rounded to float; a hit
+// beyond float's range (|t| > 3.4e38) has no float t and is a miss.
+std::optional<TriangleHit<float>> intersectWatertightInDouble(const Ray& ray, const Triangle& tri);
 
 // Exercise 1.6: the shading normal at barycentric (u, v) from the three vertex normals.
 Vec3 interpolateNormal(const Vec3& na, const Vec3& nb, const Vec3& nc, float u, float v);

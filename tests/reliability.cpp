@@ -3,15 +3,18 @@
 // object, each with a clear error or a correct image. The OBJ and message cases were found
 // by the fuzz targets in fuzz/ (their inputs are in fuzz/corpus/).
 #include <cmath>
+#include <cstring>
 #include <filesystem>
 #include <memory>
 
+#include "01_triangle/triangle.hpp"
 #include "01_triangle/triangle_grid.hpp"
 #include "04_bvh/advanced/rays.hpp"
 #include "core/app.hpp"
 #include "core/mesh.hpp"
 #include "core/render.hpp"
 #include "core/scene.hpp"
+#include "step04_support.hpp"
 #include "support.hpp"
 
 using namespace boxes;
@@ -383,5 +386,88 @@ TEST_SUITE("hard cases reliability") {
              " bytes is more than the limit of 33554432 rays")
                 .c_str(),
             InputError);
+    }
+}
+
+namespace {
+
+// Does step 04's leaf test give exercise 1.5's answer, bit for bit (t, u and v)?
+bool sameBits(float a, float b) {
+    return std::memcmp(&a, &b, sizeof a) == 0;
+}
+int leafTestsDiffer(const Ray& ray, const Triangle& tri) {
+    auto exercise = intersectWatertight(ray, tri);
+    WatertightRay prepared(ray);
+    float t = ray.tmax, u = 0.0f, v = 0.0f;
+    bool leaf = intersectLeafTriangle(prepared, LeafTriangle{tri.a, tri.b, tri.c}, t, &u, &v);
+    if (leaf != exercise.has_value()) return 1;
+    return leaf &&
+           !(sameBits(t, exercise->t) && sameBits(u, exercise->u) && sameBits(v, exercise->v));
+}
+
+}  // namespace
+
+// Step 04 keeps its own copy of exercise 1.5 (prepared once per ray: bench_leaf_test
+// measures the difference); the copy must give the exercise's bits, also where both fall
+// back to double.
+TEST_SUITE("hard cases reliability") {
+    TEST_CASE("hard case: step 04's leaf test gives exercise 1.5's bits on the hard-case rays") {
+        test::FpTrapsOff overflowOnPurpose;  // the float paths overflow before the fallback
+        const float e = std::ldexp(1.0f, -23), far = 3e38f;
+        const Vec3 b(1.0f, 1.0f + e, 1.0f), c(-(1.0f + e), -(1.0f + 2.0f * e), 1.0f);
+        const Triangle big{
+            {-1e21f, -1e21f, -5e20f}, {1e21f, -1e21f, -5e20f}, {0.0f, 1e21f, -5e20f}},
+            tiny{{-1e-15f, -1e-15f, 3.0f}, {1e-15f, -1e-15f, 3.0f}, {0.0f, 1e-15f, 3.0f}},
+            flat{{0.0f, 0.0f, 3.0f}, {1.0f, 1.0f, 3.0f}, {2.0f, 2.0f, 3.0f}},
+            unit{{-1.0f, -1.0f, -1.0f}, {1.0f, -1.0f, -1.0f}, {0.0f, 1.0f, -1.0f}},
+            upperLeft{{-1.0f, 1.0f, 1.0f}, b, c}, lowerRight{{1.0f, -1.0f, 1.0f}, c, b};
+        const Vec3 down(0.0f, 0.0f, -1.0f);
+        const std::pair<Ray, Triangle> named[] = {
+            {Ray(Vec3(0.0f), down), big},
+            {Ray(Vec3(3e21f, 0.0f, 0.0f), down), big},
+            {Ray(Vec3(0.0f, 0.0f, -5.0f), Vec3(0.0f, 0.0f, -1e28f)), tiny},
+            {Ray(Vec3(0.0f, 0.0f, -5.0f), Vec3(0.0f, 0.0f, 1e28f)), tiny},
+            {Ray(Vec3(1.0f, 1.0f, -5.0f), Vec3(0.0f, 8.149072e-10f, -1.0603488e28f)), flat},
+            {Ray(Vec3(0.0f, 0.0f, far), down), unit},
+            {Ray(Vec3(0.0f, 0.0f, far), down, nextFloatUp(far)), unit},
+            {Ray(Vec3(0.0f, 0.0f, far), Vec3(0.0f, 0.0f, -0.5f)), unit},
+            {Ray(Vec3(0.0f), Vec3(0.0f, 0.0f, 1.0f)), upperLeft},
+            {Ray(Vec3(0.0f), Vec3(0.0f, 0.0f, 1.0f)), lowerRight}};
+        for (const auto& [ray, tri] : named) CHECK(leafTestsDiffer(ray, tri) == 0);
+        // Random rays at random points of random triangles (a third of them on an edge):
+        // a soup near the origin and the same soup 1e20 away (where most tests fall back
+        // to double), each with ordinary, huge and tiny (1e-20) directions.
+        Mesh near = test04::triangleSoup(500, 17, 0.05f), farSoup = near;
+        for (Vec3& p : farSoup.positions) p = p * 1e20f + Vec3(3e20f, -1e20f, 0.0f);
+        std::mt19937_64 rng(23);
+        std::uniform_real_distribution<float> u01(0.0f, 1.0f);
+        int differ = 0, hits = 0, tests = 0;
+        for (const Mesh* m : {&near, &farSoup}) {
+            const float distance = m == &near ? 2.0f : 5e20f;
+            for (int r = 0; r < 2000; ++r) {
+                size_t i = size_t(rng() % m->triangleCount());
+                Triangle tri{m->vertex(i, 0), m->vertex(i, 1), m->vertex(i, 2)};
+                float u = u01(rng), v = u01(rng) * (1.0f - u);
+                if (r % 3 == 0) v = 1.0f - u;  // on the edge b-c
+                Vec3 target = (1.0f - u - v) * tri.a + u * tri.b + v * tri.c;
+                Vec3 offset(u01(rng) - 0.5f, u01(rng) - 0.5f, u01(rng) - 0.5f);
+                if (glm::length(offset) < 0.1f) offset = Vec3(0.0f, 0.0f, 1.0f);
+                Vec3 origin = target + glm::normalize(offset) * distance;
+                // Huge: 1e28 near, 1e15 far (5e20 * 1e28 has no float).
+                for (float scale : {1.0f, m == &near ? 1e28f : 1e15f, 1e-20f}) {
+                    Ray ray(origin, (target - origin) * scale);
+                    size_t j = (i + 1) % m->triangleCount();
+                    for (const Triangle& t :
+                         {tri, Triangle{m->vertex(j, 0), m->vertex(j, 1), m->vertex(j, 2)}}) {
+                        hits += intersectWatertight(ray, t).has_value();
+                        differ += leafTestsDiffer(ray, t);
+                        ++tests;
+                    }
+                }
+            }
+        }
+        INFO(tests << " pairs, " << hits << " hits");
+        CHECK(hits > 6000);  // most rays hit the triangle they are aimed at
+        CHECK(differ == 0);
     }
 }

@@ -360,6 +360,45 @@ TEST_SUITE("exercise 1.5") {
     }
 }
 
+// The three full tests on the closed interval's lower end and on grazing rays.
+TEST_SUITE("hard cases 01") {
+    TEST_CASE("hard case: a triangle hit exactly at t == tmin counts (closed interval)") {
+        for (TriangleTest test : kAllTriangleTests) {
+            INFO(triangleTestName(test));
+            // Straight down from z = 2 onto z = 0: t = 2 exactly in every test.
+            Ray ray(Vec3(0.25f, 0.25f, 2.0f), Vec3(0.0f, 0.0f, -1.0f), 2.0f);
+            auto h = intersectTriangle(test, ray, cast<float>(kUnit));
+            REQUIRE(h.has_value());
+            CHECK(h->t == 2.0f);
+            ray.tmin = nextFloatUp(2.0f);
+            CHECK_FALSE(intersectTriangle(test, ray, cast<float>(kUnit)));
+        }
+    }
+    TEST_CASE("hard case: grazing rays nearly parallel to a triangle hit it where double does") {
+        // Slopes from 1e-3 down to 1e-30 against the plane z = 0: D.N is tiny but not 0,
+        // so the ray meets the plane at x = 0.25. An epsilon on the determinant (|det| <
+        // 1e-8 taken for parallel) loses these hits; just beside the triangle, a miss.
+        for (TriangleTest test : kAllTriangleTests) {
+            for (float slope : {1e-3f, 1e-6f, 1e-12f, 1e-30f}) {
+                INFO(triangleTestName(test) << ", slope " << slope);
+                Ray in(Vec3(-1.0f, 0.25f, 1.25f * slope), Vec3(1.0f, 0.0f, -slope));
+                auto h = intersectTriangle(test, in, cast<float>(kUnit));
+                REQUIRE(h.has_value());
+                CHECK(double(h->t) == doctest::Approx(1.25).epsilon(1e-5));
+                CHECK(double(h->u) == doctest::Approx(0.25).epsilon(1e-4));
+                CHECK(double(h->v) == doctest::Approx(0.25).epsilon(1e-4));
+                Ray beside(Vec3(-1.0f, -0.25f, 1.25f * slope), Vec3(1.0f, 0.0f, -slope));
+                CHECK_FALSE(intersectTriangle(test, beside, cast<float>(kUnit)));
+                Rayd inDouble(Vec3d(-1.0, 0.25, 1.25 * double(slope)),
+                              Vec3d(1.0, 0.0, -double(slope)));
+                auto d = intersectTriangle(test, inDouble, kUnit);
+                REQUIRE(d.has_value());
+                CHECK(d->t == doctest::Approx(1.25).epsilon(1e-9));
+            }
+        }
+    }
+}
+
 TEST_SUITE("exercise 1.6") {
     TEST_CASE("normal interpolation: worked values") {
         Vec3 x(1, 0, 0), y(0, 1, 0), z(0, 0, 1);

@@ -261,6 +261,27 @@ TEST_SUITE("exercise 2.4") {
 }
 
 TEST_SUITE("hard cases 02") {
+    TEST_CASE("hard case: a box hit exactly at t == tmin counts (closed interval)") {
+        // The cube [-1, 1]^3 from z = 5 down: entry at t = 4 (face +z), exit at t = 6.
+        const OrientedBox cube;
+        for (BoxMethod method : {BoxMethod::SixPlanes, BoxMethod::Slabs}) {
+            INFO(boxMethodName(method));
+            auto hit = [&](float tmin) {
+                Ray ray(Vec3(0.2f, -0.3f, 5.0f), Vec3(0.0f, 0.0f, -1.0f), tmin);
+                return method == BoxMethod::SixPlanes ? intersectSixPlanes(ray, boxFacePlanes(cube))
+                                                      : intersectBoxSlabs(ray, cube);
+            };
+            auto entry = hit(4.0f);
+            REQUIRE(entry.has_value());
+            CHECK(entry->t == 4.0f);
+            CHECK(entry->entering);
+            auto exit = hit(6.0f);
+            REQUIRE(exit.has_value());
+            CHECK(exit->t == 6.0f);
+            CHECK_FALSE(exit->entering);
+            CHECK_FALSE(hit(nextFloatUp(6.0f)));
+        }
+    }
     TEST_CASE("bad input: invalid boxes are refused with a clear error") {
         OrientedBox negative;
         negative.halfExtents = Vec3(1, -1, 1);

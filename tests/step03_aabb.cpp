@@ -421,3 +421,25 @@ TEST_SUITE("program 03") {
                              {"--scene missing.obj", "no such file", 1}});
     }
 }
+
+TEST_SUITE("hard cases 03") {
+    TEST_CASE("hard case: a slab test hit exactly at t == tmin counts (closed interval)") {
+        // The cube [-1, 1]^3 from z = 5 down: the ray is inside for t in [4, 6].
+        const Bounds3f cube(Vec3(-1.0f), Vec3(1.0f));
+        for (int conservative = 0; conservative < 2; ++conservative) {
+            INFO((conservative ? "conservative" : "robust"));
+            auto slab = [&](float tmin) {
+                SlabRay ray(Ray(Vec3(0.2f, -0.3f, 5.0f), Vec3(0.0f, 0.0f, -1.0f), tmin));
+                return conservative ? intersectSlabsConservative(ray, cube)
+                                    : intersectSlabs(ray, cube);
+            };
+            auto atEntry = slab(4.0f);
+            REQUIRE(atEntry.has_value());
+            CHECK(atEntry->tnear == 4.0f);
+            auto atExit = slab(6.0f);  // the interval [6, 6]: one point, still a hit
+            REQUIRE(atExit.has_value());
+            CHECK(atExit->tnear == 6.0f);
+            if (!conservative) CHECK_FALSE(slab(nextFloatUp(6.0f)));
+        }
+    }
+}

@@ -4,6 +4,7 @@
 
 #include "core/camera.hpp"
 #include "core/ray.hpp"
+#include "core/render.hpp"
 #include "core/shapes.hpp"
 #include "support.hpp"
 
@@ -142,5 +143,34 @@ TEST_SUITE("hard cases") {
             intersectSphere(Ray(Vec3(1e5f - 10.0f, 0.0f, 0.0f), Vec3(1.0f, 0.0f, 0.0f), 1.0f), far);
         REQUIRE(t.has_value());
         CHECK(*t == doctest::Approx(20.0).epsilon(1e-3));
+    }
+}
+
+TEST_SUITE("hard cases") {
+    TEST_CASE("hard case: no self-intersection acne on spheres at scene scales 1 to 1e5") {
+        // A sphere facing the light cannot shadow itself (convex): a shadow ray from the
+        // renderer's offset origin that hits it again is acne. The offset grows with the
+        // coordinates (offsetOrigin); a fixed one falls below float's spacing at 1e5.
+        for (float scale : {1.0f, 10.0f, 100.0f, 1e3f, 1e4f, 1e5f}) {
+            const Sphere sphere{Vec3(0.2f, -0.1f, -3.0f) * scale, scale};
+            const Vec3 light = Vec3(5.0f, 5.0f, 5.0f) * scale;
+            int lit = 0, acne = 0;
+            for (int y = 0; y < 40; ++y)
+                for (int x = 0; x < 40; ++x) {
+                    Vec3 d = sphere.centre +
+                             scale * Vec3((x - 19.5f) / 20.0f, (y - 19.5f) / 20.0f, 0.0f);
+                    Ray ray(Vec3(0.0f), d);
+                    auto t = intersectSphere(ray, sphere);
+                    if (!t) continue;
+                    Vec3 p = ray.at(*t), n = glm::normalize(p - sphere.centre), toLight = light - p;
+                    if (glm::dot(n, toLight) <= 0.0f) continue;
+                    ++lit;
+                    Ray shadow(offsetOrigin(p, n, toLight), toLight, 0.0f, 1.0f);
+                    acne += intersectSphere(shadow, sphere).has_value();
+                }
+            INFO("scale " << scale << ": " << lit << " lit points");
+            CHECK(lit > 300);
+            CHECK(acne == 0);
+        }
     }
 }

@@ -261,6 +261,37 @@ TEST_SUITE("exercise 2.4") {
 }
 
 TEST_SUITE("hard cases 02") {
+    TEST_CASE("hard case: light does not leak through a closed thin wall at scales 1 to 1e5") {
+        // A shadow ray leaves the renderer's offset origin (offsetOrigin: 1e-4 times 1 + the
+        // largest coordinate, towards the light). From the underside of a closed plate
+        // with the light above, that origin lies inside the plate, and the ray must leave
+        // it through the top face: blocked. A plate thinner than the offset lets the
+        // origin jump past its top face and the light leaks: measured here at 1e-6 of the
+        // scale, where every ray leaks, and asserted zero at 1e-3.
+        for (float scale : {1.0f, 100.0f, 1e4f, 1e5f}) {
+            for (float thickness : {1e-3f, 1e-6f}) {
+                const OrientedBox plate{Vec3(0.0f), OrientedBox{}.axes,
+                                        Vec3(1.0f, 0.5f * thickness, 1.0f) * scale};
+                const Vec3 light = Vec3(0.3f, 5.0f, -0.2f) * scale, below(0.0f, -1.0f, 0.0f);
+                int leaks = 0, rays = 0;
+                for (int i = 0; i < 15; ++i)
+                    for (int k = 0; k < 15; ++k) {
+                        Vec3 p =
+                            Vec3(-0.9f + 0.12f * i, -0.5f * thickness, -0.9f + 0.12f * k) * scale;
+                        Vec3 toLight = light - p;
+                        Ray shadow(offsetOrigin(p, below, toLight), toLight, 0.0f, 1.0f);
+                        leaks += !intersectBoxSlabs(shadow, plate).has_value();
+                        ++rays;
+                    }
+                INFO("scale " << scale << ", thickness " << thickness << ": " << leaks << " of "
+                              << rays << " shadow rays leak");
+                if (thickness == 1e-3f)
+                    CHECK(leaks == 0);
+                else
+                    CHECK(leaks == rays);  // the limit: walls thinner than the offset leak
+            }
+        }
+    }
     TEST_CASE("hard case: a box hit exactly at t == tmin counts (closed interval)") {
         // The cube [-1, 1]^3 from z = 5 down: entry at t = 4 (face +z), exit at t = 6.
         const OrientedBox cube;

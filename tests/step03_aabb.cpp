@@ -311,6 +311,18 @@ TEST_SUITE("exercise 3.6") {
         CHECK(intersectionSlidePseudoCode(kUnitBox, through));
         CHECK(slabs(through, kUnitBox).has_value());
     }
+    TEST_CASE("hard case: the slide's pseudo-code misses a ray lying in a face plane where 0 / 0 is NaN") {
+        // Along +y in the plane x = 1 (or x = 0), a face plane of the closed box: D.x = 0 and
+        // O.x on the plane give (1 - 1) / 0 = NaN, and the slide's min and max let it poison
+        // the interval: a miss. The robust test (3.6) hits, entering at y = 0 (t = 1).
+        test::FpTrapsOff nanOnPurpose;  // 0 / 0 is the slide's arithmetic under test
+        for (double plane : {0.0, 1.0}) {
+            INFO("plane x = " << plane);
+            Rayd along({plane, -1, 0.5}, {0, 1, 0});
+            CHECK_FALSE(intersectionSlidePseudoCode(kUnitBox, along));
+            CHECK(slabs(along, kUnitBox).has_value());
+        }
+    }
     TEST_CASE("hard case: the slide's pseudo-code hits a box behind the ray") {
         // From (3, 0.5, 0.5) along (1, 0.125, 0): the line met the box at t in [-3, -2]
         // (y allows [-4, 4]), behind the origin. The slide's test has no t >= 0: a hit.

@@ -520,7 +520,7 @@ Question aabbUnion(Rng& rng, Question q) {
     q.solution = {
         "min = (min(Ax, Bx), min(Ay, By), min(Az, Bz)) of the min corners = " + vec(u.min),
         "max = the same with max of the max corners = " + vec(u.max),
-        "(mind each line uses its own axis: the lecture's y line has a copy-paste typo)"};
+        "(mind each line uses its own axis: the lecture's bmin.y line reads B.bmin.x)"};
     return q;
 }
 

@@ -311,7 +311,9 @@ TEST_SUITE("exercise 3.6") {
         CHECK(intersectionSlidePseudoCode(kUnitBox, through));
         CHECK(slabs(through, kUnitBox).has_value());
     }
-    TEST_CASE("hard case: the slide's pseudo-code misses a ray lying in a face plane where 0 / 0 is NaN") {
+    TEST_CASE(
+        "hard case: the slide's pseudo-code misses a ray lying in a face plane where 0 / 0 is "
+        "NaN") {
         // Along +y in the plane x = 1 (or x = 0), a face plane of the closed box: D.x = 0 and
         // O.x on the plane give (1 - 1) / 0 = NaN, and the slide's min and max let it poison
         // the interval: a miss. The robust test (3.6) hits, entering at y = 0 (t = 1).

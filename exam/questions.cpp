@@ -520,7 +520,7 @@ Question aabbUnion(Rng& rng, Question q) {
     q.solution = {
         "min = (min(Ax, Bx), min(Ay, By), min(Az, Bz)) of the min corners = " + vec(u.min),
         "max = the same with max of the max corners = " + vec(u.max),
-        "(mind each line uses its own axis: the lecture's y line has a copy-paste typo)"};
+        "(mind each line uses its own axis: the lecture's bmin.y line reads B.bmin.x)"};
     return q;
 }
 
@@ -575,8 +575,129 @@ Question frustumCull(Rng& rng, Question q) {
     return q;
 }
 
+// The lecture's terms, each asked by what it means; an answer must name one word of every
+// keyword group (lower case, found anywhere in the answer).
+struct Term {
+    std::string term, question;
+    std::vector<std::vector<std::string>> keywords;
+    std::string explanation;
+};
+
+const std::vector<Term>& terms() {
+    static const std::vector<Term> list = {
+        {"AABB",
+         "The smallest box with faces parallel to the coordinate axes that holds an object, "
+         "stored as two corners bmin and bmax: by what four-letter abbreviation is it known, "
+         "and what does it stand for?",
+         {{"aabb"}},
+         "AABB, an Axis-Aligned Bounding Box."},
+        {"slab test",
+         "By what name is the ray/AABB test known that intersects the ray with each pair of "
+         "parallel planes and keeps the overlap of the t intervals?",
+         {{"slab"}},
+         "The slab test: per axis the ray is between the two planes for one interval of t; "
+         "the ray meets the box where the three intervals overlap."},
+        {"hierarchical grouping",
+         "Objects are grouped in boxes, those boxes in bigger boxes, and so on, so that a ray "
+         "that misses a box skips everything inside it. What is this called?",
+         {{"hierarch", "bvh", "bounding volume"}},
+         "Hierarchical grouping (a bounding volume hierarchy): a ray that misses the red box "
+         "hits nothing at all; one that misses a blue box skips the green boxes inside it."},
+        {"view frustum",
+         "What is the volume of space that a camera sees called, the truncated pyramid bounded "
+         "by six planes against which boxes are culled?",
+         {{"frustum"}},
+         "The view frustum: near and far plane and four side planes through the eye."},
+        {"false negatives",
+         "The lecture calls its single-vertex culling test conservative: it keeps some boxes "
+         "that are outside the frustum but never culls one that is inside. In the lecture's "
+         "words, what does the test produce, and what does it not?",
+         {{"false negative"}},
+         "False negatives, but no false positives: the test answers 'is the box outside?', and "
+         "a box outside that it keeps is a wrong 'no'. (Counting 'visible' as the positive "
+         "answer, the same box is a false positive; the workbook follows the lecture.)"},
+        {"conservative",
+         "Culling schemes that mark some objects as visible when they are not, but never the "
+         "other way around: what is such a scheme called?",
+         {{"conservative"}},
+         "Conservative: its errors cost time (work on invisible objects), never pixels."},
+        {"global data",
+         "The rasterization pipeline renders triangles one at a time, so determining light "
+         "visibility (shadows) is non-trivial. To what does rasterization not have access?",
+         {{"global"}},
+         "Global data: a triangle being drawn knows nothing of the others, so it cannot trace "
+         "a shadow ray; shadow maps precompute that visibility in a pass of their own."},
+        {"early out",
+         "Stopping a calculation as soon as its result is known, for instance ending a shadow "
+         "ray at the first occluder it finds: what is that optimization called?",
+         {{"early"}},
+         "An early out: the shadow ray needs any hit before the light, not the nearest one."},
+        {"loop hoisting",
+         "Moving a calculation whose value does not change inside a loop to before the loop: "
+         "what is that called?",
+         {{"hoist"}},
+         "Loop hoisting, a form of precalculation: computed once instead of every iteration."},
+        {"vertex shader",
+         "Per-vertex work (transforming, lighting at the vertices) is done once per vertex "
+         "instead of once per pixel, then interpolated. In which stage of the rasterization "
+         "pipeline does that precalculation run?",
+         {{"vertex"}},
+         "The vertex shader: three vertices' work shared by every pixel of the triangle."},
+        {"look-up table",
+         "Instead of calling sin and cos, a program reads precomputed values from an array "
+         "indexed by the angle. What is that array called?",
+         {{"table", "lut"}},
+         "A look-up table (the lecture's sintab and costab); its error is the step between "
+         "entries, and its index must wrap."},
+        {"z-buffer",
+         "With which buffer does rasterization sort the pixels of primitives by depth, "
+         "keeping per pixel the nearest one drawn so far?",
+         {{"z-buffer", "z buffer", "zbuffer", "depth buffer", "depth-buffer"}},
+         "The z-buffer (depth buffer): one depth per pixel, a fragment is kept when nearer."},
+        {"tangent space",
+         "Which coordinate system is attached to a point of a surface, with axes along the "
+         "surface's tangent, bitangent and normal, and is used for normal and texture maps?",
+         {{"tangent"}},
+         "Tangent space: the frame in which a normal map's normals and the texture "
+         "coordinates' directions are given."},
+        {"clip space",
+         "In which space, after the projection matrix and before the division by w, does the "
+         "rasterizer clip triangles against the near plane?",
+         {{"clip"}},
+         "Clip space: homogeneous coordinates; clipping there, before the divide, keeps "
+         "vertices behind the eye from being mirrored."},
+        {"Moller-Trumbore",
+         "Which ray/triangle algorithm (Journal of Graphics Tools, 1997) does the lecture cite "
+         "as more efficient than intersecting the plane first?",
+         {{"moller", "möller", "moeller"}, {"trumbore"}},
+         "Moller and Trumbore, 'Fast, Minimum Storage Ray/Triangle Intersection'."},
+        {"incremental rendering",
+         "A renderer shows a quick preview while the camera moves and refines the image "
+         "while it stands still. What does the lecture call this way of improving perceived "
+         "performance?",
+         {{"incremental", "progressive"}},
+         "Incremental rendering: preview, then normal recursion, then 'photograph mode'."},
+    };
+    return list;
+}
+
 Question terminology(Rng& rng, Question q) {
-    if (rng.chance(50)) {
+    // One of the lecture's terms, the glass question of its example exam, or the choice
+    // question on what conservative means.
+    int pick = rng.pick(0, int(terms().size()) + 1);
+    if (pick < int(terms().size())) {
+        const Term& t = terms()[size_t(pick)];
+        q.statement = t.question;
+        Part p;
+        p.prompt = "the term";
+        p.type = AnswerType::Words;
+        p.keywords = t.keywords;
+        p.shown = t.term;
+        q.parts.push_back(p);
+        q.solution = {t.explanation};
+        return q;
+    }
+    if (pick == int(terms().size())) {
         q.statement = "Glass scatters light in two ways. Name both.";
         Part p;
         p.prompt = "the two kinds of scattering that glass causes";
@@ -611,7 +732,9 @@ Question terminology(Rng& rng, Question q) {
     q.solution = {
         std::string("(") + p.choice + ") " + options[0] + ".",
         "A box outside the frustum near its corners can have its p-vertex inside every "
-        "plane: it is kept (a false positive), costing time but never pixels.",
+        "plane: it is kept although it is outside. The lecture calls that a false negative "
+        "(the test answers 'is the box outside?' and wrongly says no); counting 'visible' as "
+        "the positive answer it would be a false positive. It costs time, never pixels.",
         "Testing the frustum's corners against the box's planes as well removes most of them."};
     return q;
 }
@@ -626,7 +749,13 @@ Question workedExample(Rng&, Question q) {
     q.given["radius2"] = {20};
     q.statement =
         "The eye is at E = (1, 1, 1) and looks along V = (1, 0, 1). The sphere is "
-        "|p - C| = sqrt(20) with C = (-1, 1, -1). Exact forms such as sqrt(10)-1 are fine.";
+        "|p - C| = sqrt(20) with C = (-1, 1, -1). Exact forms such as sqrt(10)-1 are fine.\n"
+        "(The first question of the lecture's example exam, parts b to e. Where its text is "
+        "ambiguous this version decides: the ray r runs from E along V; the up vector, "
+        "printed equal to V, is not needed here; E lies inside the sphere, so 'the "
+        "intersection' is where r leaves it, the point P of part e, and the normal asked is "
+        "the one pointing inside; the plane '-X - Z = 10' lies behind the eye, so x + z = 10 "
+        "is asked too.)";
     auto t = intersectSphere(ray, s);
     Vec3d p = ray.at(*t), inward = -(p - s.centre) / s.radius;
     Part leave = numbersPart("where the ray from E along V leaves the sphere", values(p), 3);
@@ -678,16 +807,25 @@ const std::vector<KindEntry>& kindTable() {
         {{"aabb-overlap", "whether two closed axis-aligned boxes overlap"}, aabbOverlap},
         {{"frustum-cull", "the single-vertex (p-vertex) test of a box against a frustum plane"},
          frustumCull},
-        {{"terminology", "conservative culling; the two kinds of scattering glass causes"},
+        {{"terminology",
+          "the lecture's terms (AABB, slab test, frustum, false negatives, global data, ...); "
+          "conservative culling; the two kinds of scattering glass causes"},
          terminology},
         {{"worked-example",
-          "the WORKBOOK's worked example: E = (1,1,1), V = (1,0,1), the sphere |p - C| = sqrt(20)"},
+          "the lecture's example exam, question 1: E = (1,1,1), V = (1,0,1), the sphere "
+          "|p - C| = sqrt(20)"},
          workedExample},
     };
     return table;
 }
 
 }  // namespace
+
+std::vector<std::string> terminologyTerms() {
+    std::vector<std::string> names;
+    for (const Term& t : terms()) names.push_back(t.term);
+    return names;
+}
 
 const std::vector<QuestionKind>& questionKinds() {
     static const std::vector<QuestionKind> kinds = [] {

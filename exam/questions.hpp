@@ -46,9 +46,13 @@ struct QuestionKind {
 const std::vector<QuestionKind>& questionKinds();
 
 // The question of one kind for one seed (the same seed gives the same numbers). The kind
-// "worked-example" is the WORKBOOK's fixed example. Throws std::invalid_argument for an
+// "worked-example" is the lecture's example exam's first question, with fixed numbers. Throws std::invalid_argument for an
 // unknown kind.
 Question makeQuestion(const std::string& kind, uint64_t seed);
+
+// The lecture's terms that the kind "terminology" asks for (besides the glass and the
+// conservative-culling questions), as the solution names them.
+std::vector<std::string> terminologyTerms();
 
 enum class Verdict { Correct, Wrong, Unreadable };
 struct Checked {

@@ -23,6 +23,9 @@
 //   <!-- exercises: 01_triangle -->                  the step's exercise markers as a table
 //   <!-- code: 01_triangle NAME|EXERCISE 1.4 [max=N] [nocomments] -->
 //                                                     a function from the step's sources
+//   <!-- check: 02_box:facts{pixels_disagreeing} == 0 -->
+//                                                     removed: a stated outcome that
+//                                                     slides/claims.mjs checks against the report
 // A step that does not exist (or whose program fails) gets a visible "not built yet" note.
 import { spawnSync } from "node:child_process";
 import fs from "node:fs";
@@ -452,6 +455,8 @@ function exercisesHtml(step) {
 
 function expand(markdown, deck, args, deckDir) {
   const deckStep = /^\d\d_/.test(deck) ? deck : null;
+  // Stated outcomes' checks (slides/claims.mjs reads them) are for the test, not the notes.
+  markdown = markdown.replace(/^[ \t]*<!--\s*check:.*?-->[ \t]*\r?\n/gm, "");
   return markdown.replace(/^[ \t]*<!--\s*(image|table|plot|fact|machine|code|exercises):?\s*(.*?)\s*-->[ \t]*$/gm, (_, kind, rest) => {
     const words = [...rest.matchAll(/(\w+)="([^"]*)"|(\S+)/g)].map((m) => (m[3] !== undefined ? m[3] : `${m[1]}=${m[2]}`));
     if (kind === "machine") return machineHtml(deckStep, args);

@@ -3,7 +3,7 @@
 // Chromium and checks that it loads without console errors or network requests, that its
 // slide count matches the Markdown, that every image resolves with a non-zero size, that
 // every formula rendered (no raw $...$, no MathJax error) and that no slide's content
-// overflows its frame. Saves OUT/slides/NAME-slide1.png (the first slide) and
+// overflows its frame, and that every stated outcome agrees with its report (claims.mjs). Saves OUT/slides/NAME-slide1.png (the first slide) and
 // OUT/slides/NAME-formula.png (the first slide with a formula) for a person to look at.
 //
 // usage: node slides/check.mjs [--out DIR] [--bin BUILD_DIR] [--no-build] [--no-pdf] [--every-slide]
@@ -179,6 +179,11 @@ try {
   await context.close();
   fs.rmSync(profile, { recursive: true, force: true });
 }
+
+// Every stated outcome of the decks and READMEs against the reports just used.
+const claims = spawnSync(process.execPath, [path.join(here, "claims.mjs"), "--out", args.out], { encoding: "utf8" });
+process.stdout.write(claims.stdout + claims.stderr);
+if (claims.status === 1) results.push({ name: "stated outcomes", failures: ["slides/claims.mjs: a stated outcome disagrees with its report (above)"] });
 
 let failed = 0;
 for (const r of results) {

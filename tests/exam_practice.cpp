@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <cmath>
 #include <optional>
+#include <set>
 
 #include "exam/answer.hpp"
 #include "exam/questions.hpp"
@@ -358,15 +359,27 @@ TEST_SUITE("exam practice") {
         CHECK(culled < kSeeds);
     }
     TEST_CASE("generated questions: terminology") {
+        // Every term of the lecture is asked within 400 seeds; its own name is a right
+        // answer, a neighbouring term's is not.
+        std::vector<std::string> names = terminologyTerms();
+        REQUIRE(names.size() >= 10);
+        std::set<std::string> seen;
         bool sawGlass = false, sawCulling = false;
-        for (int seed = 0; seed < 40; ++seed) {
+        for (int seed = 0; seed < 400; ++seed) {
             Question q = makeQuestion("terminology", uint64_t(seed));
             const Part& p = q.parts.at(0);
-            if (p.type == AnswerType::Words) {
+            if (p.type == AnswerType::Words && p.shown == "reflection and refraction") {
                 sawGlass = true;
                 CHECK(checkAnswer(p, "Reflection and refraction").verdict == Verdict::Correct);
                 CHECK(checkAnswer(p, "it reflects and transmits").verdict == Verdict::Correct);
                 CHECK(checkAnswer(p, "reflection").verdict == Verdict::Wrong);
+            } else if (p.type == AnswerType::Words) {
+                INFO(p.shown);
+                REQUIRE(std::find(names.begin(), names.end(), p.shown) != names.end());
+                seen.insert(p.shown);
+                CHECK(checkAnswer(p, p.shown).verdict == Verdict::Correct);
+                CHECK(checkAnswer(p, "I do not know").verdict == Verdict::Wrong);
+                CHECK(q.solution.size() == 1);
             } else {
                 sawCulling = true;
                 REQUIRE(p.type == AnswerType::Choice);
@@ -381,8 +394,53 @@ TEST_SUITE("exam practice") {
         }
         CHECK(sawGlass);
         CHECK(sawCulling);
+        CHECK(seen.size() == names.size());
+        // Terms of the lecture that must be among them (its cursive ones included).
+        for (const char* term :
+             {"AABB", "slab test", "view frustum", "false negatives", "conservative", "global data",
+              "vertex shader", "z-buffer", "tangent space", "hierarchical grouping"})
+            CHECK(std::find(names.begin(), names.end(), std::string(term)) != names.end());
     }
-    TEST_CASE("the worked example: the WORKBOOK's exact numbers") {
+    TEST_CASE("generated questions: culling terminology uses the lecture's false negative") {
+        // The lecture: the conservative test produces false negatives, no false positives.
+        // The term question accepts that answer, and the choice question's solution names
+        // the lecture's word for the box kept although it is outside.
+        bool sawTerm = false, sawChoice = false;
+        for (int seed = 0; seed < 400; ++seed) {
+            Question q = makeQuestion("terminology", uint64_t(seed));
+            const Part& p = q.parts.at(0);
+            if (p.shown == "false negatives") {
+                sawTerm = true;
+                CHECK(checkAnswer(p, "False negatives, but no false positives").verdict ==
+                      Verdict::Correct);
+                CHECK(checkAnswer(p, "false positives").verdict == Verdict::Wrong);
+            } else if (p.type == AnswerType::Choice) {
+                sawChoice = true;
+                REQUIRE(q.solution.size() >= 2);
+                CHECK(q.solution[1].find("The lecture calls that a false negative") !=
+                      std::string::npos);
+                CHECK(q.solution[1].find("kept although it is outside") != std::string::npos);
+            }
+        }
+        CHECK(sawTerm);
+        CHECK(sawChoice);
+    }
+    TEST_CASE("exam: the worked example notes where the lecture's question is ambiguous") {
+        Question q = makeQuestion("worked-example", 3);
+        for (const char* note :
+             {"first question of the lecture's example exam", "the ray r runs from E along V",
+              "up vector", "E lies inside the sphere", "'-X - Z = 10' lies behind"}) {
+            INFO(note);
+            CHECK(q.statement.find(note) != std::string::npos);
+        }
+        // What the notes decide is what the parts ask: the exit point, the inward normal,
+        // no hit with -x - z = 10.
+        REQUIRE(q.parts.size() == 4);
+        CHECK(q.parts[0].prompt.find("leaves") != std::string::npos);
+        CHECK(q.parts[1].prompt.find("inside") != std::string::npos);
+        CHECK(q.parts[3].expected.empty());
+    }
+    TEST_CASE("the worked example: the exact numbers of the lecture's example exam") {
         Question q = makeQuestion("worked-example", 7);
         REQUIRE(q.parts.size() == 4);
         double r10 = std::sqrt(10.0), s = std::sqrt(0.5);

@@ -172,6 +172,21 @@ TEST_SUITE("exercise 2.2") {
     TEST_CASE("six planes: hard cases") {
         checkBoxHardCases(BoxMethod::SixPlanes);
     }
+    TEST_CASE("hard case: a ray aimed exactly at an edge hits the closed box") {
+        // From (-2, -2, 0.5) along (1, 1, 0) at the edge x = y = -1 of the cube [-1, 1]^3: the
+        // planes x = -1 and y = -1 both give t = 1, and the point (-1, -1, 0.5) lies exactly
+        // on the other one. "The same side of the remaining planes" must include the plane
+        // itself: with a strict test both hits are rejected and the ray passes through.
+        Rayd ray({-2, -2, 0.5}, {1, 1, 0});
+        auto planes = planesOf(unitCube());
+        Vec3d p = ray.at(1.0);
+        CHECK(glm::dot(planes[0].normal, p) + planes[0].d == 0.0);  // on the -x plane
+        CHECK(glm::dot(planes[2].normal, p) + planes[2].d == 0.0);  // and on the -y plane
+        auto h = intersectSixPlanes(ray, planes);
+        REQUIRE(h.has_value());
+        CHECK(h->t == 1.0);
+        CHECK(h->entering);
+    }
 }
 
 TEST_SUITE("exercise 2.3") {

@@ -157,20 +157,33 @@ TEST_SUITE("exercise 3.4") {
         CHECK(unionBounds(Bounds3d(), a) == a);
         CHECK(unionBounds(a, Bounds3d()) == a);
     }
-    TEST_CASE("hard case: the slide's y line repeats x and breaks boxes whose x and y differ") {
-        // x in [0, 1] but y in [10, 20]: the typo gives y the x extent [0, 1].
-        Bounds3d a({0, 10, 0}, {1, 20, 1}), b({0.5, 12, 0}, {2, 25, 1});
-        Bounds3d wrong = unionBoundsSlideTypo(a, b);
+    TEST_CASE("hard case: the slide's bmin.y line reads B.bmin.x and loses the bottom of B") {
+        // The slide: box.bmin.y = min(A.bmin.y, B.bmin.x). B lies below A in y, and B's x
+        // minimum (5) is above A's y minimum (0): the typo starts y at 0 and B's y extent
+        // [-3, -2] is outside the "union".
+        Bounds3d A({0, 0, 0}, {1, 1, 1}), B({5, -3, 0}, {6, -2, 1});
+        Bounds3d wrong = unionBoundsSlideTypo(A, B);
+        Bounds3d right = unionBounds(A, B);
         CHECK(wrong.min.y == 0.0);
-        CHECK(wrong.max.y == 2.0);
-        CHECK_FALSE(wrong.contains(Vec3d(0.5, 15, 0.5)));  // a point of a is outside it
-        Bounds3d right = unionBounds(a, b);
-        CHECK(right.min.y == 10.0);
-        CHECK(right.max.y == 25.0);
-        CHECK(right.contains(Vec3d(0.5, 15, 0.5)));
-        // For a cube at the origin the typo is invisible: why it survives on a slide.
+        CHECK(right.min.y == -3.0);
+        CHECK_FALSE(wrong.contains(Vec3d(5.5, -2.5, 0.5)));  // B's centre is outside it
+        CHECK(right.contains(Vec3d(5.5, -2.5, 0.5)));
+        // One operand only: every other line of the slide is right.
+        CHECK(wrong.min.x == right.min.x);
+        CHECK(wrong.max.x == right.max.x);
+        CHECK(wrong.max.y == right.max.y);
+        CHECK(wrong.min.z == right.min.z);
+        CHECK(wrong.max.z == right.max.z);
+        // The other way round the typo makes the box too big (B.bmin.x = -4 below both y
+        // minima): conservative, only slower.
+        Bounds3d C({-4, 10, 0}, {-3, 11, 1});
+        CHECK(unionBoundsSlideTypo(A, C).min.y == -4.0);
+        CHECK(unionBounds(A, C).min.y == 0.0);
+        // Where B.bmin.x equals B.bmin.y (cubes on the diagonal) the typo does not matter:
+        // why it survives on a slide.
         Bounds3d c({0, 0, 0}, {1, 1, 1}), d({0.5, 0.5, 0.5}, {2, 2, 2});
         CHECK(unionBoundsSlideTypo(c, d) == unionBounds(c, d));
+        CHECK(unionBoundsSlideTypo(d, c) == unionBounds(d, c));
     }
 }
 
@@ -192,16 +205,30 @@ TEST_SUITE("exercise 3.5") {
         }
     }
     TEST_CASE("hard case: the slide's half test reports a false overlap") {
-        // b lies entirely beyond a's max side on x: a.min <= b.max holds on every axis, so
-        // the half test says "overlap"; the other half (b.min <= a.max) fails on x.
-        Bounds3d a({0, 0, 0}, {1, 1, 1}), b({5, 0, 0}, {6, 1, 1});
-        CHECK(overlapsHalfTest(a, b));
-        CHECK_FALSE(overlaps(a, b));
-        CHECK_FALSE(overlaps(b, a));
-        CHECK_FALSE(overlapsHalfTest(b, a));  // the other order happens to catch it
+        // The slide: (A.bmin.x < B.bmax.x) && (A.bmin.y < B.bmax.y) && (A.bmin.z < B.bmax.z).
+        // B lies entirely beyond A's max side on x: A.bmin < B.bmax holds on every axis, so
+        // the half test says "overlap"; the missing half (B.bmin <= A.bmax) fails on x.
+        Bounds3d A({0, 0, 0}, {1, 1, 1}), B({5, 0, 0}, {6, 1, 1});
+        CHECK(overlapsHalfTest(A, B));
+        CHECK_FALSE(overlaps(A, B));
+        CHECK_FALSE(overlaps(B, A));
+        CHECK_FALSE(overlapsHalfTest(B, A));  // the other order happens to catch it
         Bounds3f af({0, 0, 0}, {1, 1, 1}), bf({0, 0, 5}, {1, 1, 6});
         CHECK(overlapsHalfTest(af, bf));
         CHECK_FALSE(overlaps(af, bf));
+        // Boxes that really overlap: the slide's test agrees.
+        Bounds3d C({0.5, 0.5, 0.5}, {2, 2, 2});
+        CHECK(overlapsHalfTest(A, C));
+        CHECK(overlaps(A, C));
+    }
+    TEST_CASE(
+        "hard case: the slide's strict comparison says touching closed boxes do not overlap") {
+        // A starts where B ends on x (A.bmin.x = B.bmax.x = 1): closed boxes share the face
+        // x = 1, but 1 < 1 is false.
+        Bounds3d A({1, 0, 0}, {2, 1, 1}), B({0, 0, 0}, {1, 1, 1});
+        CHECK_FALSE(overlapsHalfTest(A, B));
+        CHECK(overlaps(A, B));
+        CHECK(overlaps(B, A));
     }
 }
 
@@ -270,6 +297,56 @@ TEST_SUITE("exercise 3.6") {
         auto h = slabs(Rayd({-1, 0.5, 0.5}, {1, 0, 0}), Bounds3d({0, nan, 0}, {1, 1, 1}));
         CHECK(h.has_value());
         CHECK_FALSE(slabs(Rayd({-1, 0.5, 5}, {1, 0, 0}), Bounds3d({0, nan, 0}, {1, 1, 1})));
+    }
+    TEST_CASE(
+        "hard case: the slide's pseudo-code tests only x and y and hits a ray beside the box") {
+        // From (-1, 0.5, 5) along (1, 0.25, 0): inside the x slab for t in [1, 2] and the y
+        // slab for t in [-2, 2], but at z = 5, far outside the box's z in [0, 1]. The slide
+        // never looks at z: a hit.
+        Rayd beside({-1, 0.5, 5}, {1, 0.25, 0});
+        CHECK(intersectionSlidePseudoCode(kUnitBox, beside));
+        CHECK_FALSE(slabs(beside, kUnitBox).has_value());
+        // A ray that does pass through the box: both say hit.
+        Rayd through({-1, 0.25, 0.5}, {2, 1, 0});
+        CHECK(intersectionSlidePseudoCode(kUnitBox, through));
+        CHECK(slabs(through, kUnitBox).has_value());
+    }
+    TEST_CASE(
+        "hard case: the slide's pseudo-code misses a ray lying in a face plane where 0 / 0 is "
+        "NaN") {
+        // Along +y in the plane x = 1 (or x = 0), a face plane of the closed box: D.x = 0 and
+        // O.x on the plane give (1 - 1) / 0 = NaN, and the slide's min and max let it poison
+        // the interval: a miss. The robust test (3.6) hits, entering at y = 0 (t = 1).
+        test::FpTrapsOff nanOnPurpose;  // 0 / 0 is the slide's arithmetic under test
+        for (double plane : {0.0, 1.0}) {
+            INFO("plane x = " << plane);
+            Rayd along({plane, -1, 0.5}, {0, 1, 0});
+            CHECK_FALSE(intersectionSlidePseudoCode(kUnitBox, along));
+            CHECK(slabs(along, kUnitBox).has_value());
+        }
+    }
+    TEST_CASE("hard case: the slide's pseudo-code hits a box behind the ray") {
+        // From (3, 0.5, 0.5) along (1, 0.125, 0): the line met the box at t in [-3, -2]
+        // (y allows [-4, 4]), behind the origin. The slide's test has no t >= 0: a hit.
+        Rayd away({3, 0.5, 0.5}, {1, 0.125, 0});
+        CHECK(intersectionSlidePseudoCode(kUnitBox, away));
+        CHECK_FALSE(slabs(away, kUnitBox).has_value());
+    }
+    TEST_CASE(
+        "hard case: the slide's start values t_min = +inf and t_max = -inf never report a hit") {
+        // Straight through the middle of the box: max(+inf, ...) stays +inf and min(-inf, ...)
+        // stays -inf, so t_min < t_max is never true.
+        Rayd centre({-1, 0.5, 0.5}, {1, 0.25, 0.125});
+        CHECK_FALSE(intersectionSlideFormulas(centre, kUnitBox));
+        const double inf = std::numeric_limits<double>::infinity();
+        CHECK(intersectionSlideFormulas(centre, kUnitBox, -inf, inf));  // swapped back: a hit
+        CHECK(slabs(centre, kUnitBox).has_value());
+        // With the start values right, the slide's strict t_min < t_max still misses a flat
+        // box (t_min = t_max = 2) that its own code (tmax >= tmin) and 3.6 hit.
+        Bounds3d flat({0, 0, 0}, {1, 0, 1});
+        Rayd down({0.5, 2, 0.5}, {0.125, -1, 0.25});
+        CHECK_FALSE(intersectionSlideFormulas(down, flat, -inf, inf));
+        CHECK(slabs(down, flat).has_value());
     }
     TEST_CASE("robust slab test against the exact answer on hard rays") {
         // The hard rays include origins on slab planes with zero direction components:

@@ -246,7 +246,15 @@ void measureBoxTests(const StepRun& run, BoxSet& set, size_t raysPerBox, Report&
         {disagreePath, "magenta: pixels where six planes and slabs see another box or face"});
     std::cerr << "02_box: measuring both methods...\n";
     BoxRaySet rays = makeBoxRays(64, raysPerBox, run.options.seed);
-    for (Table& t : measureBoxMethods(rays, 11)) report.add(std::move(t));
+    for (Table& t : measureBoxMethods(rays, 11)) {
+        if (t.id == "box_speed") {
+            // Rows: six planes float, double; slabs float, double (the decks quote the ratio).
+            double planes = std::get<double>(t.rows.at(0)[2]),
+                   slabs = std::get<double>(t.rows.at(2)[2]);
+            report.facts["slab_speedup_float"] = planes / std::max(1e-30, slabs);
+        }
+        report.add(std::move(t));
+    }
     Disagreement d = compareMethods(rays);
     Table dis;
     dis.id = "method_disagreement";
@@ -261,6 +269,9 @@ void measureBoxTests(const StepRun& run, BoxSet& set, size_t raysPerBox, Report&
              pixels.maxRelativeT});
     report.add(dis);
     report.facts["pixels_disagreeing"] = pixels.differ;
+    report.facts["random_rays"] = d.rays;
+    report.facts["random_rays_hit_miss_differ"] = d.hitMiss;
+    report.facts["random_rays_face_differs"] = d.face;
     report.plots.push_back(
         {{"table", "box_accuracy"},
          {"x", "ns/test"},

@@ -2,6 +2,8 @@
 // and the slab test, made robust. The box itself is core's Bounds3T (closed: [min, max]).
 #pragma once
 
+#include <algorithm>
+#include <limits>
 #include <optional>
 
 #include "01_triangle/triangle.hpp"  // TriangleT, as a data type only
@@ -29,18 +31,21 @@ Bounds3f meshBounds(const Mesh& mesh);
 template <typename T>
 Bounds3T<T> unionBounds(const Bounds3T<T>& a, const Bounds3T<T>& b);
 
-// The lecture slide's union with its copy-paste typo: the y line repeats the x line, so
-// y gets x's extent (kept to show in the tests and the README what it breaks).
+// The lecture's union slide, line for line, typo included: its bmin.y line takes the
+// minimum of A.bmin.y and B.bmin.x (every other line is right). The y extent then starts
+// at B's x minimum whenever that is below both y minima (too big: only slower), and misses
+// the bottom of B whenever B.bmin.y lies below A.bmin.y and B.bmin.x (too small: lost hits).
+// Kept for the tests and docs/errata.md.
 template <typename T>
-Bounds3T<T> unionBoundsSlideTypo(const Bounds3T<T>& a, const Bounds3T<T>& b) {
-    Bounds3T<T> r;
-    r.min.x = std::min(a.min.x, b.min.x);
-    r.max.x = std::max(a.max.x, b.max.x);
-    r.min.y = std::min(a.min.x, b.min.x);  // the typo: .x where .y belongs
-    r.max.y = std::max(a.max.x, b.max.x);
-    r.min.z = std::min(a.min.z, b.min.z);
-    r.max.z = std::max(a.max.z, b.max.z);
-    return r;
+Bounds3T<T> unionBoundsSlideTypo(const Bounds3T<T>& A, const Bounds3T<T>& B) {
+    Bounds3T<T> box;
+    box.min.x = std::min(A.min.x, B.min.x);
+    box.max.x = std::max(A.max.x, B.max.x);
+    box.min.y = std::min(A.min.y, B.min.x);  // the slide's typo: B.bmin.x where B.bmin.y belongs
+    box.max.y = std::max(A.max.y, B.max.y);
+    box.min.z = std::min(A.min.z, B.min.z);
+    box.max.z = std::max(A.max.z, B.max.z);
+    return box;
 }
 
 // Exercise 3.5: do two closed boxes overlap? On every axis each box must begin before the
@@ -48,11 +53,13 @@ Bounds3T<T> unionBoundsSlideTypo(const Bounds3T<T>& a, const Bounds3T<T>& b) {
 template <typename T>
 bool overlaps(const Bounds3T<T>& a, const Bounds3T<T>& b);
 
-// The slide's half condition (only a.min <= b.max on each axis): reports a false overlap
-// whenever b lies entirely beyond a's max side.
+// The lecture's overlap slide as written: (A.bmin.x < B.bmax.x) && (A.bmin.y < B.bmax.y)
+// && (A.bmin.z < B.bmax.z). Two errors: half the condition (B.bmin < A.bmax is missing,
+// so a B entirely beyond A's max side "overlaps"), and strict < (closed boxes that touch,
+// A.bmin = B.bmax, "do not").
 template <typename T>
-bool overlapsHalfTest(const Bounds3T<T>& a, const Bounds3T<T>& b) {
-    return a.min.x <= b.max.x && a.min.y <= b.max.y && a.min.z <= b.max.z;
+bool overlapsHalfTest(const Bounds3T<T>& A, const Bounds3T<T>& B) {
+    return (A.min.x < B.max.x) && (A.min.y < B.max.y) && (A.min.z < B.max.z);
 }
 
 // A ray prepared for many box tests: the reciprocal direction is computed once.
@@ -94,12 +101,52 @@ template <typename T>
 std::optional<RayInterval<T>> intersectSlabsConservative(const SlabRayT<T>& ray,
                                                          const Bounds3T<T>& box);
 
-// The slab test as the slide has it: divide by D, order the two t per axis with std::min and
-// std::max, and narrow [tmin, tmax]. NaN (origin on a plane, D_k = 0) makes its answer depend
-// on the order of the arguments of min and max: `swapArguments` flips that order.
+// The naive slab test: the slide's pseudo-code completed (all three axes, the ray's
+// [tmin, tmax], a hit when tnear <= tfar): divide by D, order the two t per axis with
+// std::min and std::max. NaN (origin on a plane, D_k = 0) makes its answer depend on the
+// order of the arguments of min and max: `swapArguments` flips that order.
 template <typename T>
 std::optional<RayInterval<T>> intersectSlabsNaive(const RayT<T>& ray, const Bounds3T<T>& box,
                                                   bool swapArguments = false);
+
+// The lecture's slab pseudo-code, line for line ("r.0" is the origin O): x and y only, no
+// z, no t >= 0, and `return tmax >= tmin`. It answers "does the infinite line meet the
+// box's x-y rectangle": a ray passing above the box in z, or a box behind the ray, is a hit.
+template <typename T>
+bool intersectionSlidePseudoCode(const Bounds3T<T>& b, const RayT<T>& r) {
+    T tx1 = (b.min.x - r.origin.x) / r.direction.x;
+    T tx2 = (b.max.x - r.origin.x) / r.direction.x;
+
+    T tmin = std::min(tx1, tx2);
+    T tmax = std::max(tx1, tx2);
+
+    T ty1 = (b.min.y - r.origin.y) / r.direction.y;
+    T ty2 = (b.max.y - r.origin.y) / r.direction.y;
+
+    tmin = std::max(tmin, std::min(ty1, ty2));
+    tmax = std::min(tmax, std::max(ty1, ty2));
+
+    return tmax >= tmin;
+}
+
+// The slab slide's formulas as written: start with t_min = +inf, t_max = -inf, per axis
+// t_min = max(t_min, min(t1, t2)) and t_max = min(t_max, max(t1, t2)), a hit if
+// t_min < t_max. The start values are swapped, so t_min stays +inf and t_max -inf and no
+// ray ever hits. `tminStart` and `tmaxStart` let a test put them right (-inf, +inf) to show
+// the other error: the strict < misses a flat box, where t_min = t_max.
+template <typename T>
+bool intersectionSlideFormulas(const RayT<T>& ray, const Bounds3T<T>& box,
+                               T tminStart = std::numeric_limits<T>::infinity(),
+                               T tmaxStart = -std::numeric_limits<T>::infinity()) {
+    T tmin = tminStart, tmax = tmaxStart;
+    for (int k = 0; k < 3; ++k) {
+        T t1 = (box.min[k] - ray.origin[k]) / ray.direction[k];
+        T t2 = (box.max[k] - ray.origin[k]) / ray.direction[k];
+        tmin = std::max(tmin, std::min(t1, t2));
+        tmax = std::min(tmax, std::max(t1, t2));
+    }
+    return tmin < tmax;
+}
 
 // A stand-in of 1e30 for 1/0 (a common trick; tinybvh PR #286 removed it): finite, so no
 // NaN, but a ray lying in a face plane gets t = 0 there instead of "all t", and misses a box

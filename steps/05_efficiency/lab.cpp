@@ -6,7 +6,7 @@
 namespace boxes {
 
 LectureSinTable::LectureSinTable() : table(3600) {
-    // for (int i = 0; i < 3600; i++) sinTable[i] = (float)Math.Sin(i / 10);
+    // The slide: for( int i = 0; i < 3600; i++ ) { sintab[i] = Math.Sin( i / 10 ); ...
     for (int i = 0; i < 3600; ++i) table[size_t(i)] = float(std::sin(double(i / 10)));
 }
 

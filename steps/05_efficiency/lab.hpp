@@ -19,7 +19,7 @@ namespace boxes {
 // ---- Sine and cosine from a table -------------------------------------------------------
 
 // What the lecture's code does, transcribed to C++ so a test can show it: the table is
-// filled with Math.Sin(i / 10) (integer division, and degrees fed to a function that wants
+// filled with `sintab[i] = Math.Sin( i / 10 );` (integer division, and degrees fed to a function that wants
 // radians) and read with table[(int)(a * 10)] for an angle a in degrees (no wrap). Where
 // the lecture would read outside the table (negative angles, 360 degrees and more) this
 // returns nullopt instead of undefined behaviour.

@@ -1,5 +1,7 @@
 #include "core/app.hpp"
 
+#include <charconv>
+#include <cmath>
 #include <cstdlib>
 #include <iostream>
 #include <sstream>
@@ -62,7 +64,66 @@ void addCommonOptions(CLI::App& app, CommonOptions& o, const std::string& defaul
     app.add_option("--screenshot", o.screenshot, "window: save the last frame to this PNG");
 }
 
+namespace {
+
+// CLI11 reads numbers with strtoll, strtoull and strtold in base 0: "-1" for an unsigned
+// flag wrapped to 2^64 - 1, an unsigned overflow became 2^64 - 1, "010" was octal 8 and
+// "0x10" 16, and "1e999" or "nan" reached the range checks. Every numeric flag's text is
+// checked first: a decimal integer ("-" only for signed ones) or a finite decimal number,
+// all of it; CLI11 then refuses what does not fit the flag's own type or range.
+// An integer's leading zeros are dropped (CLI11 would read "010" as octal 8).
+std::string strictNumber(std::string& text, const std::string& kind) {
+    const char* begin = text.data();
+    const char* end = begin + text.size();
+    const std::string shown = "'" + printable(text, 40) + "'";
+    if (kind == "FLOAT") {
+        double value = 0.0;
+        auto [ptr, ec] = std::from_chars(begin, end, value);
+        if (ec == std::errc::result_out_of_range && ptr == end) return shown + " is out of range";
+        if (ec != std::errc() || ptr != end || !std::isfinite(value))
+            return shown + " is not a finite decimal number";
+        return "";
+    }
+    uint64_t unsignedValue = 0;
+    int64_t signedValue = 0;
+    auto [ptr, ec] = kind == "UINT" ? std::from_chars(begin, end, unsignedValue)
+                                    : std::from_chars(begin, end, signedValue);
+    bool digits =
+        !text.empty() && text.find_first_not_of("0123456789", text[0] == '-') == std::string::npos;
+    if (ec == std::errc::result_out_of_range && ptr == end) return shown + " is out of range";
+    if (ec != std::errc() || ptr != end || !digits)
+        return shown + (kind == "UINT" && text[0] == '-' && digits
+                            ? " is negative (a count or seed is 0 or more)"
+                            : " is not a decimal integer");
+    size_t sign = text[0] == '-', first = text.find_first_not_of('0', sign);
+    text = text.substr(0, sign) + (first == std::string::npos ? "0" : text.substr(first));
+    return "";
+}
+
+// The option's value type as CLI11 names it in the help ("INT", "UINT", "FLOAT"), before
+// any validator's description.
+std::string numberKind(const CLI::Option& option) {
+    std::string type = option.get_type_name();
+    type = type.substr(0, type.find(':'));
+    return type == "INT" || type == "UINT" || type == "FLOAT" ? type : "";
+}
+
+void addStrictNumbers(CLI::App& app) {
+    for (CLI::Option* option : app.get_options()) {
+        std::string kind = numberKind(*option);
+        // transform() puts the check before the option's own (range) checks.
+        if (!kind.empty())
+            option->transform(CLI::Validator(
+                [kind](std::string& text) { return strictNumber(text, kind); }, "", "number"));
+    }
+    for (CLI::App* sub : app.get_subcommands([](CLI::App*) { return true; }))
+        addStrictNumbers(*sub);
+}
+
+}  // namespace
+
 void parseCommandLine(CLI::App& app, int argc, char** argv) {
+    addStrictNumbers(app);
     try {
         app.parse(argc, argv);
     } catch (const CLI::CallForHelp&) {
@@ -85,13 +146,9 @@ Vec3 parseVec3(const std::string& text, const std::string& flag) {
         std::string field = i < 2 ? rest.substr(0, comma) : rest;
         if ((i < 2 && comma == std::string::npos) || field.empty())
             throw InputError(flag + ": expected X,Y,Z, got '" + printable(text) + "'");
-        size_t used = 0;
-        try {
-            v[i] = std::stof(field, &used);
-        } catch (const std::exception&) {
-            used = 0;
-        }
-        if (used != field.size() || !std::isfinite(v[i]))
+        // from_chars: decimal only, all of the field (std::stof took "0x1p3", leading blanks).
+        auto [ptr, ec] = std::from_chars(field.data(), field.data() + field.size(), v[i]);
+        if (ec != std::errc() || ptr != field.data() + field.size() || !std::isfinite(v[i]))
             throw InputError(flag + ": '" + printable(field) + "' is not a finite number");
         if (i < 2) rest = rest.substr(comma + 1);
     }

@@ -68,12 +68,44 @@ namespace {
 // them ("\n", "\r" or "\r\n"; leading blanks skipped):
 // - vertex lines: tinyobjloader reads a non-numeric coordinate as 0 without a word, so a
 //   malformed file would be silently flattened;
-// - face lines: at most kMaxFaceVertices vertices (tinyobjloader's one-byte count);
+// - face, line and point lines: tinyobjloader reads an index with atoi, so 2^32 + 3 wrapped
+//   to 3, "3.5" and "3abc" became 3 and a missing vt or vn was not noticed. Each number
+//   must be a decimal integer and nothing else, within the v, vt or vn lines read so far;
+// - faces of 3 to kMaxFaceVertices vertices (tinyobjloader's count is one byte; a face of
+//   two made no triangle and was dropped silently);
+// - "s" (smoothing group) lines: "off" or an integer in int range (atoi again); "t" (tag)
+//   lines, which the workbook does not use and tinyobjloader reads with atoi, are refused;
 // - the totals: at most kMaxObjVertices vertices and kMaxObjTriangles triangles, counted
 //   here so memory is bounded before anything is allocated.
 // tinyobjloader's "vw VERTEX JOINT WEIGHT ..." (skin weights, unused here) converts each
 // joint to int unchecked: 1e38 is undefined behaviour (found by fuzzing). Every field must
-// be a plain number, the vertex and joints integers in int range.
+// be a plain number, the vertex and joints decimal integers in int range (checkSkinWeights).
+bool isBlank(char c) {
+    return c == ' ' || c == '\t';
+}
+
+// Whitespace-separated fields (tinyobjloader also splits at blanks only), at most `max`.
+std::vector<std::string_view> splitFields(std::string_view rest, size_t max) {
+    std::vector<std::string_view> fields;
+    for (size_t i = 0; i < rest.size() && fields.size() < max;) {
+        while (i < rest.size() && isBlank(rest[i])) ++i;
+        size_t j = i;
+        while (j < rest.size() && !isBlank(rest[j])) ++j;
+        if (j > i) fields.push_back(rest.substr(i, j - i));
+        i = j;
+    }
+    return fields;
+}
+
+// An exact decimal integer: an optional "-", digits, nothing else (no "+", no blanks).
+enum class IntegerText { Ok, NotInteger, TooLarge };
+IntegerText exactInteger(std::string_view text, int64_t& value) {
+    const char* end = text.data() + text.size();
+    auto [ptr, ec] = std::from_chars(text.data(), end, value);
+    if (ec == std::errc::result_out_of_range && ptr == end) return IntegerText::TooLarge;
+    return ec == std::errc() && ptr == end ? IntegerText::Ok : IntegerText::NotInteger;
+}
+
 template <typename Where>
 void checkSkinWeights(std::string_view rest, const Where& where) {
     size_t index = 0;
@@ -83,11 +115,17 @@ void checkSkinWeights(std::string_view rest, const Where& where) {
         while (j < rest.size() && rest[j] != ' ' && rest[j] != '\t') ++j;
         if (j == i) break;
         std::string_view field = rest.substr(i, j - i);
-        double value = 0.0;
-        auto [ptr, ec] = std::from_chars(field.data(), field.data() + field.size(), value);
         bool integer = index == 0 || index % 2 == 1;  // the vertex, then joint, weight, ...
-        if (ec != std::errc() || ptr != field.data() + field.size() || !std::isfinite(value) ||
-            (integer && !(value >= 0.0 && value < 2147483648.0 && value == std::floor(value))))
+        bool ok = false;
+        if (integer) {
+            int64_t k = 0;
+            ok = exactInteger(field, k) == IntegerText::Ok && k >= 0 && k <= INT32_MAX;
+        } else {
+            double value = 0.0;
+            auto [ptr, ec] = std::from_chars(field.data(), field.data() + field.size(), value);
+            ok = ec == std::errc() && ptr == field.data() + field.size() && std::isfinite(value);
+        }
+        if (!ok)
             throw InputError(where() + "vertex weight field '" + printable(field, 40) +
                              "' is not " + (integer ? "an index" : "a number"));
         ++index;
@@ -95,9 +133,55 @@ void checkSkinWeights(std::string_view rest, const Where& where) {
     }
 }
 
+// How many v, vt and vn lines came before: a face may use only those.
+struct ObjCounts {
+    size_t vertices = 0, texcoords = 0, normals = 0;
+};
+
+// One face, line or point token: "V", "V/T", "V//N" or "V/T/N". Each number k is 1..count
+// (from the first line read so far) or -count..-1 (back from the last one).
+void checkIndexToken(std::string_view token, const ObjCounts& counts, const std::string& where) {
+    const std::string shown = "'" + printable(token, 40) + "'";
+    std::string_view parts[3];
+    size_t n = 0;
+    for (size_t start = 0;; ++n) {
+        size_t slash = token.find('/', start);
+        if (n == 3 || (n == 2 && slash != std::string_view::npos)) {
+            n = 0;  // more than three parts
+            break;
+        }
+        parts[n] = token.substr(start, slash == std::string_view::npos ? slash : slash - start);
+        if (slash == std::string_view::npos) {
+            ++n;
+            break;
+        }
+        start = slash + 1;
+    }
+    // The vertex always; the texture coordinate empty only in V//N; the normal, when there.
+    if (n == 0 || parts[0].empty() || (n == 2 && parts[1].empty()) || (n == 3 && parts[2].empty()))
+        throw InputError(where + "index " + shown + " is not V, V/T, V//N or V/T/N");
+    const char* what[3] = {"vertex", "texture coordinate", "normal"};
+    const char* lines[3] = {"v", "vt", "vn"};
+    const size_t available[3] = {counts.vertices, counts.texcoords, counts.normals};
+    for (size_t p = 0; p < n; ++p) {
+        if (parts[p].empty()) continue;  // V//N
+        const std::string number = printable(parts[p], 40);
+        int64_t k = 0;
+        IntegerText kind = exactInteger(parts[p], k);
+        if (kind == IntegerText::NotInteger)
+            throw InputError(where + "index " + shown + ": " + what[p] + " '" + number +
+                             "' is not a decimal integer");
+        uint64_t size = kind == IntegerText::Ok ? (k < 0 ? 0 - uint64_t(k) : uint64_t(k)) : 0;
+        if (kind == IntegerText::TooLarge || k == 0 || size > available[p])
+            throw InputError(where + "index " + shown + ": " + what[p] + " " + number +
+                             " is out of range (" + std::to_string(available[p]) + " " + lines[p] +
+                             " lines so far)");
+    }
+}
+
 void checkLines(std::string_view text, const std::string& name, const ObjLimits& limits) {
-    auto isBlank = [](char c) { return c == ' ' || c == '\t'; };
-    size_t lineNumber = 0, vertices = 0, triangles = 0;
+    size_t lineNumber = 0, triangles = 0;
+    ObjCounts counts;
     size_t pos = 0;
     while (pos < text.size()) {
         size_t end = text.find_first_of("\r\n", pos);
@@ -110,49 +194,63 @@ void checkLines(std::string_view text, const std::string& name, const ObjLimits&
         while (first < line.size() && isBlank(line[first])) ++first;
         line.remove_prefix(first);
         auto where = [&] { return name + ":" + std::to_string(lineNumber) + ": "; };
-        if (line.size() >= 3 && line[0] == 'v' && line[1] == 'w' && isBlank(line[2])) {
+        // The keyword: tinyobjloader's test is the letters followed by a blank.
+        auto keyword = [&](std::string_view k) {
+            return line.size() > k.size() && line.substr(0, k.size()) == k &&
+                   isBlank(line[k.size()]);
+        };
+        if (keyword("vw")) {
             checkSkinWeights(line.substr(3), where);
-            continue;
+        } else if (keyword("vt")) {
+            ++counts.texcoords;
+        } else if (keyword("vn")) {
+            ++counts.normals;
+        } else if (keyword("f") || keyword("l") || keyword("p")) {
+            // Faces: one more than the limit is enough to refuse them.
+            auto fields = splitFields(
+                line.substr(2), line[0] == 'f' ? kMaxFaceVertices + 1 : std::string_view::npos);
+            if (line[0] == 'f') {
+                if (fields.size() > kMaxFaceVertices)
+                    throw InputError(where() + "a face of more than " +
+                                     std::to_string(kMaxFaceVertices) + " vertices");
+                if (fields.size() < 3)
+                    throw InputError(where() + "a face of " + std::to_string(fields.size()) +
+                                     " vertices (at least 3)");
+                triangles += fields.size() - 2;
+                if (triangles > limits.triangles)
+                    throw InputError(name + ": more than " + std::to_string(limits.triangles) +
+                                     " triangles (the limit)");
+            }
+            for (std::string_view field : fields) checkIndexToken(field, counts, where());
+        } else if (keyword("s")) {
+            auto fields = splitFields(line.substr(2), 2);
+            int64_t group = 0;
+            if (fields.size() > 1 || (fields.size() == 1 && fields[0] != "off" &&
+                                      !(exactInteger(fields[0], group) == IntegerText::Ok &&
+                                        group >= 0 && group <= INT32_MAX)))
+                throw InputError(where() + "smoothing group '" + printable(line.substr(2), 40) +
+                                 "' is not 'off' or one integer from 0 to 2147483647");
+        } else if (keyword("t")) {
+            throw InputError(where() + "tag lines ('t') are not read by the workbook");
+        } else if (keyword("v")) {
+            auto fields = splitFields(line.substr(2), 3);
+            for (std::string_view field : fields) {
+                float value = 0.0f;
+                const char* fieldEnd = field.data() + field.size();
+                auto [ptr, ec] = std::from_chars(field.data(), fieldEnd, value);
+                std::string shown = printable(field, 40);
+                if (ec == std::errc::result_out_of_range)
+                    throw InputError(where() + "coordinate '" + shown + "' is out of float range");
+                if (ec != std::errc() || ptr != fieldEnd)
+                    throw InputError(where() + "coordinate '" + shown + "' is not a number");
+                if (!std::isfinite(value))
+                    throw InputError(where() + "coordinate '" + shown + "' is non-finite");
+            }
+            if (fields.size() < 3) throw InputError(where() + "a vertex needs 3 coordinates");
+            if (++counts.vertices > limits.vertices)
+                throw InputError(name + ": more than " + std::to_string(limits.vertices) +
+                                 " vertices (the limit)");
         }
-        if (line.size() < 2 || !isBlank(line[1]) || (line[0] != 'v' && line[0] != 'f')) continue;
-        // Whitespace-separated fields after the keyword (tinyobjloader also splits at
-        // blanks only).
-        std::vector<std::string_view> fields;
-        for (size_t i = 1; i < line.size();) {
-            while (i < line.size() && isBlank(line[i])) ++i;
-            size_t j = i;
-            while (j < line.size() && !isBlank(line[j])) ++j;
-            if (j > i) fields.push_back(line.substr(i, j - i));
-            if (line[0] == 'v' && fields.size() == 3) break;
-            if (fields.size() > kMaxFaceVertices) break;
-            i = j;
-        }
-        if (line[0] == 'f') {
-            if (fields.size() > kMaxFaceVertices)
-                throw InputError(where() + "a face of more than " +
-                                 std::to_string(kMaxFaceVertices) + " vertices");
-            if (fields.size() >= 3) triangles += fields.size() - 2;
-            if (triangles > limits.triangles)
-                throw InputError(name + ": more than " + std::to_string(limits.triangles) +
-                                 " triangles (the limit)");
-            continue;
-        }
-        for (std::string_view field : fields) {
-            float value = 0.0f;
-            const char* fieldEnd = field.data() + field.size();
-            auto [ptr, ec] = std::from_chars(field.data(), fieldEnd, value);
-            std::string shown = printable(field, 40);
-            if (ec == std::errc::result_out_of_range)
-                throw InputError(where() + "coordinate '" + shown + "' is out of float range");
-            if (ec != std::errc() || ptr != fieldEnd)
-                throw InputError(where() + "coordinate '" + shown + "' is not a number");
-            if (!std::isfinite(value))
-                throw InputError(where() + "coordinate '" + shown + "' is non-finite");
-        }
-        if (fields.size() < 3) throw InputError(where() + "a vertex needs 3 coordinates");
-        if (++vertices > limits.vertices)
-            throw InputError(name + ": more than " + std::to_string(limits.vertices) +
-                             " vertices (the limit)");
     }
 }
 
@@ -170,23 +268,25 @@ Mesh parseObj(const std::string& text, const std::string& name, const ObjLimits&
         throw InputError(name + ": the file is empty");
     checkLines(text, name, limits);
 
-    tinyobj::ObjReaderConfig config;
-    config.triangulate = false;  // we fan-triangulate ourselves, in file order
-    config.vertex_color = false;
-    config.mtl_search_path = "";
-    tinyobj::ObjReader reader;
-    // An empty material text: the mesh's own materials are not used by the workbook.
-    if (!reader.ParseFromString(text, "", config))
-        throw InputError(name + ": " +
-                         firstLine(reader.Error().empty() ? "cannot parse" : reader.Error()));
-    const tinyobj::attrib_t& attrib = reader.GetAttrib();
+    // No material reader: tinyobjloader then skips "mtllib" lines, so a path an OBJ file
+    // names is never opened (the workbook's materials come from the scene, not the file).
+    // No triangulation: we fan-triangulate ourselves, in file order.
+    tinyobj::attrib_t attrib;
+    std::vector<tinyobj::shape_t> shapes;
+    std::vector<tinyobj::material_t> materials;
+    std::string warning, error;
+    std::istringstream stream(text);
+    if (!tinyobj::LoadObj(&attrib, &shapes, &materials, &warning, &error, &stream,
+                          /*readMatFn=*/nullptr, /*triangulate=*/false,
+                          /*default_vcols_fallback=*/false))
+        throw InputError(name + ": " + firstLine(error.empty() ? "cannot parse" : error));
     Mesh mesh;
     size_t vertexCount = attrib.vertices.size() / 3;
     mesh.positions.reserve(vertexCount);
     for (size_t i = 0; i < vertexCount; ++i)
         mesh.positions.emplace_back(attrib.vertices[3 * i], attrib.vertices[3 * i + 1],
                                     attrib.vertices[3 * i + 2]);
-    for (const auto& shape : reader.GetShapes()) {
+    for (const auto& shape : shapes) {
         size_t offset = 0;
         for (unsigned char faceSize : shape.mesh.num_face_vertices) {
             const auto* idx = &shape.mesh.indices[offset];

@@ -1,6 +1,7 @@
 #include "exam/answer.hpp"
 
 #include <cctype>
+#include <charconv>
 #include <cmath>
 #include <numbers>
 #include <stdexcept>
@@ -44,12 +45,11 @@ std::vector<Token> tokenize(const std::string& s) {
         t.spaceBefore = space;
         char c = s[i];
         if (std::isdigit(static_cast<unsigned char>(c)) || c == '.') {
-            size_t used = 0;
-            try {
-                t.value = std::stod(s.substr(i), &used);
-            } catch (const std::exception&) {
+            // from_chars reads decimals only: std::stod read "0x10" as 16.
+            auto [ptr, ec] = std::from_chars(s.data() + i, s.data() + s.size(), t.value);
+            size_t used = size_t(ptr - (s.data() + i));
+            if (ec != std::errc() || used == 0)
                 throw std::invalid_argument("could not read a number at '" + s.substr(i) + "'");
-            }
             t.kind = Token::Number;
             t.text = s.substr(i, used);
             i += used;

@@ -64,8 +64,8 @@ TEST_SUITE("core") {
     }
     TEST_CASE("mesh: OBJ polygons are fan-triangulated in file order") {
         Mesh m = parseObj(
-            "v 0 0 0\nv 1 0 0\nv 1 1 0\nv 0 1 0\nv 0 0 1\nf 1 2 3 4\nf 1/1/1 2/2/2 5/3/3\nf -1 -2 "
-            "-3\n");
+            "v 0 0 0\nv 1 0 0\nv 1 1 0\nv 0 1 0\nv 0 0 1\nvt 0 0\nvt 1 0\nvt 0 1\nvn 0 0 1\nvn 0 1 "
+            "0\nvn 1 0 0\nf 1 2 3 4\nf 1/1/1 2/2/2 5/3/3\nf -1 -2 -3\n");
         REQUIRE(m.triangleCount() == 4);
         CHECK(m.triangles[0] == std::array<uint32_t, 3>{0, 1, 2});
         CHECK(m.triangles[1] == std::array<uint32_t, 3>{0, 2, 3});

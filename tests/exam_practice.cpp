@@ -498,6 +498,45 @@ TEST_SUITE("exam practice") {
         auto show = test::runProgram(program, "--kind ray-box --seed 5 --count 3 --show", dir);
         CHECK(show.out.find(makeQuestion("ray-box", 6).statement) != std::string::npos);
     }
+    TEST_CASE("program: --count and --seed that overflow or have a fraction or junk are refused") {
+        // CLI11 alone read --seed -1 as 2^64 - 1 and an overflowing seed as 2^64 - 1.
+        test::TempDir dir;
+        for (auto [args, expect] : std::vector<std::pair<std::string, std::string>>{
+                 {"--count 99999999999999999999",
+                  "--count: '99999999999999999999' is out of range"},
+                 {"--count 2.5", "--count: '2.5' is not a decimal integer"},
+                 {"--count 3x", "--count: '3x' is not a decimal integer"},
+                 {"--seed 18446744073709551616", "--seed: '18446744073709551616' is out of range"},
+                 {"--seed 1.5", "--seed: '1.5' is not a decimal integer"},
+                 {"--seed 7abc", "--seed: '7abc' is not a decimal integer"},
+                 {"--seed -1", "--seed: '-1' is negative"}}) {
+            INFO(args);
+            auto run = test::runProgram(program, "--show " + args, dir);
+            CHECK(run.exitCode == 2);
+            CHECK(test::lineCount(run.err) == 1);
+            CHECK(run.err.find("exam_practice: error: " + expect) == 0);
+        }
+        // The largest seed is read as itself: question 1 shows it.
+        auto run = test::runProgram(
+            program, "--kind ray-box --seed 18446744073709551615 --count 1 --show", dir);
+        CHECK(run.exitCode == 0);
+        CHECK(run.out.find("--seed 18446744073709551615") != std::string::npos);
+    }
+    TEST_CASE("answer parser: numbers that overflow or have junk are refused") {
+        // std::stod read "0x10" as 16; from_chars reads decimals only.
+        for (const char* bad : {"1e999", "-1e999", "0x10", "3abc", "2.5x", "1.5.2"}) {
+            INFO(bad);
+            CHECK_THROWS_AS(evaluateExpression(bad), std::invalid_argument);
+        }
+        CHECK_THROWS_AS(parseNumberList("(1, 2, 3x)"), std::invalid_argument);
+        CHECK_THROWS_WITH_AS(evaluateExpression("1e999"),
+                             doctest::Contains("could not read a number at '1e999'"),
+                             std::invalid_argument);
+        // A fraction is a number like any other: read exactly (to the nearest double).
+        CHECK(evaluateExpression("2.5") == 2.5);
+        CHECK(evaluateExpression(".125") == 0.125);
+        CHECK(parseNumberList("(0.1, 2e-3, 1e308)") == std::vector<double>{0.1, 2e-3, 1e308});
+    }
     TEST_CASE("program: bad input gives one line and a non-zero exit") {
         test::TempDir dir;
         for (auto [args, expect] : std::vector<std::pair<std::string, std::string>>{

@@ -9,7 +9,9 @@ import unittest
 import xml.etree.ElementTree as ET
 
 sys.path.insert(0, os.path.dirname(os.path.dirname(os.path.dirname(os.path.abspath(__file__)))))
-from tools.grading import grade, sandbox  # noqa: E402
+from tools.grading import class_bench, grade, grade_class, gradescope, sandbox  # noqa: E402
+sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
+import test_strict_numbers  # noqa: E402
 from tools.grading.exercises import CaseResult, Exercise  # noqa: E402
 from tools.grading.grade import CaseOutcome, case_outcome, exercise_row  # noqa: E402
 
@@ -271,6 +273,37 @@ class GradeInto(unittest.TestCase):
         r = grade.grade_into(tempfile.mkdtemp(), tree, grade.GradeOptions(steps=["99"], no_isolation=True))
         self.assertEqual(r.code, 1)
         self.assertIn("grade: --steps 99: no such step with exercises", r.last_line)
+
+
+class StrictNumbers(test_strict_numbers.FlagChecks, unittest.TestCase):
+    """Every number on the grader's command lines: an overflowing, a fractional and a
+    trailing-junk value refused with one line naming the flag and the value."""
+
+    def test_grade(self):
+        for flag in ("--memory", "--build-memory", "--jobs"):
+            self.check(grade.main, ["tree"], flag, self.BAD_INTEGERS)
+        for flag in ("--timeout", "--output", "--build-timeout"):
+            self.check(grade.main, ["tree"], flag, self.BAD_DECIMALS)
+        self.check(grade.main, ["tree"], "--steps", ("999", "1.5", "01x"))
+
+    def test_grade_class(self):
+        self.check(grade_class.main, ["subs"], "--jobs", self.BAD_INTEGERS)
+        for flag in ("--timeout", "--student-timeout"):
+            self.check(grade_class.main, ["subs"], flag, self.BAD_DECIMALS)
+        self.check(grade_class.main, ["subs"], "--steps", ("999", "1.5", "01x"))
+
+    def test_gradescope_bundle(self):
+        for flag in ("--timeout", "--limit"):
+            self.check(gradescope.main, ["bundle", "a.zip"], flag, self.BAD_DECIMALS)
+        self.check(gradescope.main, ["bundle", "a.zip"], "--steps", ("999", "1.5", "01x"))
+
+    def test_class_bench(self):
+        for flag in ("--students", "--seed", "--jobs"):
+            self.check(class_bench.main, ["bench"], flag, self.BAD_INTEGERS)
+        self.check(class_bench.main, ["bench"], "--jobs", ("1,99999999999999999999999", "1,2.5", "1,2x"))
+        self.check(class_bench.main, ["bench"], "--timeout", self.BAD_DECIMALS)
+        for flag in ("--students", "--seed"):
+            self.check(class_bench.main, ["make", "dest"], flag, self.BAD_INTEGERS)
 
 
 if __name__ == "__main__":

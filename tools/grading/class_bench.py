@@ -34,6 +34,7 @@ import tarfile
 import zipfile
 
 from . import ROOT, grade_class
+from .strict_numbers import MAX_JOBS, MAX_SECONDS, decimal, integer, integer_list, step_list
 from .exercises import exercises, step_sources
 from .kit import strip_solutions, write_kit
 
@@ -201,11 +202,11 @@ def run_class(subs, out, work, jobs, steps, timeout):
 
 def bench(args):
     out = os.path.abspath(args.out)
-    steps = [s.zfill(2) for s in args.steps.split(",")]
+    steps = args.steps
     print(f"[bench-grading] a class of {args.students} in {out}/class (steps {','.join(steps)})",
           file=sys.stderr)
     make_class(os.path.join(out, "class"), args.students, steps, args.seed)
-    jobs_list = [int(j) for j in args.jobs.split(",")]
+    jobs_list = args.jobs
     work = os.path.abspath(args.work) if args.work else os.path.join(out, "work")
     rows = []
     for jobs in jobs_list:
@@ -239,23 +240,23 @@ def main(argv):
     sub = p.add_subparsers(dest="command", required=True)
     m = sub.add_parser("make")
     m.add_argument("dest")
-    m.add_argument("--students", type=int, default=30)
-    m.add_argument("--steps", default="01")
-    m.add_argument("--seed", type=int, default=1)
+    m.add_argument("--students", type=integer(1, 10000), default=30)
+    m.add_argument("--steps", type=step_list, default="01")
+    m.add_argument("--seed", type=integer(0, 2**63 - 1), default=1)
     c = sub.add_parser("check")
     c.add_argument("out")
     c.add_argument("expected")
     b = sub.add_parser("bench")
-    b.add_argument("--students", type=int, default=30)
-    b.add_argument("--steps", default="01")
-    b.add_argument("--seed", type=int, default=1)
-    b.add_argument("--jobs", default="1,2")
-    b.add_argument("--timeout", type=float, default=10.0, help="seconds per test case (default 10)")
+    b.add_argument("--students", type=integer(1, 10000), default=30)
+    b.add_argument("--steps", type=step_list, default="01")
+    b.add_argument("--seed", type=integer(0, 2**63 - 1), default=1)
+    b.add_argument("--jobs", type=integer_list(1, MAX_JOBS), default="1,2")
+    b.add_argument("--timeout", type=decimal(0, MAX_SECONDS), default=10.0, help="seconds per test case (default 10)")
     b.add_argument("--out", default=os.path.join(ROOT, "build", "bench-grading"))
     b.add_argument("--work", help="the grading folders (default OUT/work; kept between runs)")
     args = p.parse_args(argv)
     if args.command == "make":
-        expected = make_class(args.dest, args.students, [s.zfill(2) for s in args.steps.split(",")], args.seed)
+        expected = make_class(args.dest, args.students, args.steps, args.seed)
         print(f"[class] {len(expected)} submissions in {args.dest}/submissions, expected points in "
               f"{args.dest}/expected.json", file=sys.stderr)
         return 0

@@ -50,6 +50,7 @@ import xml.etree.ElementTree as ET
 from dataclasses import dataclass
 
 from . import ROOT, sandbox
+from .strict_numbers import MAX_JOBS, MAX_MB, MAX_SECONDS, decimal, integer, step_list
 from .exercises import (BEGIN, MAX_RESULT_BYTES, SOURCE_SUFFIXES, case_results, exercises, step_dirs,
                         step_sources)
 from .kit import strip_solutions, tracked_files
@@ -930,21 +931,21 @@ def main(argv):
     p.add_argument("--hidden", help="folder of extra doctest files stepNN*.cpp")
     p.add_argument("--junit", help="JUnit XML file to write (default WORK/grade.xml)")
     p.add_argument("--json", help="also write the per-exercise results as JSON to this file")
-    p.add_argument("--timeout", type=float, default=defaults.timeout,
+    p.add_argument("--timeout", type=decimal(0, MAX_SECONDS), default=defaults.timeout,
                    help="time limit of one test case in seconds, wall clock (default %(default)g)")
-    p.add_argument("--memory", type=int, default=defaults.memory,
+    p.add_argument("--memory", type=integer(1, MAX_MB), default=defaults.memory,
                    help="memory limit of a test process in MB, address space (default %(default)d)")
-    p.add_argument("--output", type=float, default=defaults.output,
+    p.add_argument("--output", type=decimal(0, MAX_MB), default=defaults.output,
                    help="output limit in MB: what a test or a build prints, and any file a test "
                         "writes (default %(default)g)")
-    p.add_argument("--build-timeout", type=float, default=defaults.build_timeout,
+    p.add_argument("--build-timeout", type=decimal(0, MAX_SECONDS), default=defaults.build_timeout,
                    help="time limit of one step's build in seconds (default %(default)g; the first "
                         "build compiles the core too)")
-    p.add_argument("--build-memory", type=int, default=defaults.build_memory,
+    p.add_argument("--build-memory", type=integer(1, MAX_MB), default=defaults.build_memory,
                    help="memory limit of each compiler or linker process in MB (default %(default)d)")
-    p.add_argument("--steps", help="grade only these steps, e.g. 01,03")
+    p.add_argument("--steps", type=step_list, help="grade only these steps, e.g. 01,03")
     p.add_argument("--work", help="where the grading tree and its build live (default build/grade)")
-    p.add_argument("--jobs", type=int, default=defaults.jobs, help="parallel compile jobs (default %(default)d)")
+    p.add_argument("--jobs", type=integer(1, MAX_JOBS), default=defaults.jobs, help="parallel compile jobs (default %(default)d)")
     p.add_argument("--no-isolation", "--no-sandbox", dest="no_isolation", action="store_true",
                    help="build and run student code WITHOUT bubblewrap (the limits still hold); "
                         "only for code you trust, where bubblewrap cannot run")
@@ -952,12 +953,9 @@ def main(argv):
                                   "unprivileged user, which must not be able to read this tree; every "
                                   "process of it is killed after each command")
     args = p.parse_args(argv)
-    for flag in ("timeout", "memory", "output", "build_timeout", "build_memory", "jobs"):
-        if getattr(args, flag) <= 0:
-            p.error(f"--{flag.replace('_', '-')} must be positive")
     opts = GradeOptions(**{f.name: getattr(args, f.name) for f in dataclasses.fields(GradeOptions)
                            if hasattr(args, f.name)})
-    opts.steps = [s.zfill(2) for s in args.steps.split(",")] if args.steps else None
+    opts.steps = args.steps
     try:
         grade(args.student, opts)
     except GradeError as e:

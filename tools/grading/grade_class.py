@@ -34,6 +34,7 @@ import time
 from concurrent.futures import ThreadPoolExecutor, as_completed
 
 from . import ROOT, sandbox
+from .strict_numbers import MAX_JOBS, MAX_SECONDS, decimal, integer, step_list
 from .exercises import exercises
 from .grade import GradeOptions, grade_into
 from .kit import tracked_files
@@ -290,7 +291,9 @@ def grade_class(opts):
     os.makedirs(os.path.join(opts.out, "students"), exist_ok=True)
     all_ex = exercises(ROOT)
     numbers = sorted({f"{e.step:02d}" for e in all_ex})
-    opts.steps = [s.zfill(2) for s in opts.steps.split(",")] if opts.steps else None
+    if isinstance(opts.steps, str):  # a caller's "01,02" rather than the command line's list
+        opts.steps = step_list(opts.steps)
+    opts.steps = opts.steps or None
     bad = [s for s in opts.steps or [] if s not in numbers]
     if bad:
         raise SystemExit(f"grade-class: --steps {','.join(bad)}: no such step (steps: {','.join(numbers)})")
@@ -395,12 +398,12 @@ def main(argv):
     p.add_argument("submissions", help="folder with one folder, git repository or archive per student")
     p.add_argument("--out", default=os.path.join(ROOT, "build", "class-grades"),
                    help="where the results go (default build/class-grades)")
-    p.add_argument("--jobs", type=int, default=sandbox.usable_cpus(),
+    p.add_argument("--jobs", type=integer(1, MAX_JOBS), default=sandbox.usable_cpus(),
                    help="students graded at once (default: the cores this process may use)")
     p.add_argument("--hidden", help="folder of extra doctest files stepNN*.cpp (as for grade)")
-    p.add_argument("--steps", help="grade only these steps, e.g. 01,03")
-    p.add_argument("--timeout", type=float, default=60.0, help="seconds per test case (default 60)")
-    p.add_argument("--student-timeout", type=float, default=1800.0,
+    p.add_argument("--steps", type=step_list, help="grade only these steps, e.g. 01,03")
+    p.add_argument("--timeout", type=decimal(0, MAX_SECONDS), default=60.0, help="seconds per test case (default 60)")
+    p.add_argument("--student-timeout", type=decimal(0, MAX_SECONDS), default=1800.0,
                    help="seconds for one student's whole grading (default 1800)")
     p.add_argument("--work", help="folder of the workers' grading folders (default OUT/work)")
     p.add_argument("--no-cache", action="store_true", help="grade every submission again")

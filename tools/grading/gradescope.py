@@ -43,6 +43,7 @@ import traceback
 import zipfile
 
 from . import ROOT, sandbox
+from .strict_numbers import MAX_SECONDS, decimal, step_list
 from .exercises import exercises
 from .grade_class import run_grader
 from .kit import tracked_files
@@ -115,9 +116,9 @@ def hidden_case_names(hidden):
 
 def bundle(args):
     numbers = sorted({f"{e.step:02d}" for e in exercises(ROOT)})
-    steps = [s.zfill(2) for s in args.steps.split(",")] if args.steps else numbers
+    steps = args.steps or numbers
     if any(s not in numbers for s in steps):
-        raise SystemExit(f"gradescope: --steps {args.steps}: steps are {','.join(numbers)}")
+        raise SystemExit(f"gradescope: --steps {','.join(steps)}: steps are {','.join(numbers)}")
     if args.timeout >= args.limit:
         raise SystemExit(f"gradescope: --timeout {args.timeout:g} must be below --limit {args.limit:g}")
     config = {"steps": steps, "timeout": args.timeout, "limit": args.limit, "user": args.user,
@@ -363,9 +364,9 @@ def main(argv):
     b = sub.add_parser("bundle", help="write the autograder zip")
     b.add_argument("out", help="the zip to write, e.g. autograder.zip")
     b.add_argument("--hidden", help="folder of extra doctest files stepNN*.cpp")
-    b.add_argument("--steps", help="grade only these steps, e.g. 01,02 (default all)")
-    b.add_argument("--timeout", type=float, default=60.0, help="seconds per test case (default 60)")
-    b.add_argument("--limit", type=float, default=DEFAULT_LIMIT,
+    b.add_argument("--steps", type=step_list, help="grade only these steps, e.g. 01,02 (default all)")
+    b.add_argument("--timeout", type=decimal(0, MAX_SECONDS), default=60.0, help="seconds per test case (default 60)")
+    b.add_argument("--limit", type=decimal(0, MAX_SECONDS), default=DEFAULT_LIMIT,
                    help="seconds for the whole grading of a submission, below the assignment's "
                         "Gradescope timeout (default %(default)g: Gradescope's default is 10 minutes)")
     b.add_argument("--user", default=DEFAULT_USER,

@@ -48,6 +48,11 @@ import threading
 import time
 from dataclasses import dataclass
 
+try:  # a module of tools.grading, or run as a script (sandbox.sh)
+    from .strict_numbers import MAX_MB, MAX_SECONDS, decimal, integer
+except ImportError:
+    from strict_numbers import MAX_MB, MAX_SECONDS, decimal, integer
+
 # What the C++ runtime, glibc, GCC and Python print when an allocation is refused: under an
 # address-space limit that is the normal way a memory hog ends.
 MEMORY_SIGNS = (b"std::bad_alloc", b"bad_alloc", b"Cannot allocate memory", b"out of memory",
@@ -665,10 +670,10 @@ def main(argv):
     p = argparse.ArgumentParser(prog="tools/grading/sandbox.sh", description=__doc__.split("\n\n")[0],
                                 epilog="\n\n".join(__doc__.split("\n\n")[2:]),
                                 formatter_class=argparse.RawDescriptionHelpFormatter)
-    p.add_argument("--time", type=float, default=10.0, help="wall-clock seconds (default 10)")
-    p.add_argument("--memory", type=int, default=1024, help="address space in MB per process (default 1024)")
-    p.add_argument("--output", type=float, default=16.0, help="MB printed, and per file written (default 16)")
-    p.add_argument("--processes", type=int, default=256,
+    p.add_argument("--time", type=decimal(0, MAX_SECONDS), default=10.0, help="wall-clock seconds (default 10)")
+    p.add_argument("--memory", type=integer(1, MAX_MB), default=1024, help="address space in MB per process (default 1024)")
+    p.add_argument("--output", type=decimal(0, MAX_MB), default=16.0, help="MB printed, and per file written (default 16)")
+    p.add_argument("--processes", type=integer(1, 1 << 20), default=256,
                    help="processes and threads at once (default 256)")
     p.add_argument("--dir", help="the writable working folder (default: a new temporary one)")
     p.add_argument("--no-isolation", action="store_true", help="limits only, no bubblewrap (trusted code)")

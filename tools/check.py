@@ -439,28 +439,29 @@ def wait_for_change(root, poll):
     tool = shutil.which("inotifywait")
     if tool and not poll:
         steps = os.path.join(root, "steps")
-        r = subprocess.run([tool, "-q", "-r", "-e", "close_write,moved_to,create,delete", steps],
+        r = subprocess.run([tool, "-q", "-r", "-e", "close_write,moved_to,create,delete",
+                            "--format", "%w%f", steps],
                            stdout=subprocess.PIPE, stderr=subprocess.DEVNULL, text=True)
         if r.returncode in (0, 2):  # 2: the timeout, which is not set here
             time.sleep(0.1)  # an editor writes a file in more than one step
-            return r.stdout.strip()
+            return r.stdout.strip().splitlines()[0] if r.stdout.strip() else os.path.join(root, "steps")
     before = snapshot(root)
     while True:
         time.sleep(0.5)
         now = snapshot(root)
         if now != before:
             changed = sorted(set(now.items()) ^ set(before.items()))
-            return changed[0][0] if changed else ""
+            return changed[0][0] if changed else os.path.join(root, "steps")
 
 
 def watch(root, chosen, opts, everything):
     how = "inotifywait" if shutil.which("inotifywait") and not opts.poll else "polling every 0.5 s"
-    changed = ""
+    changed = None
     while True:
         sys.stdout.write("\033[2J\033[H")  # clear the screen
         sys.stdout.flush()
-        if changed:
-            say(f"[check] {os.path.relpath(changed.split(' ')[0], root) if changed else ''} changed: checking again")
+        if changed is not None:
+            say(f"[check] {os.path.relpath(changed, root)} changed: checking again")
         rows = check_once(root, chosen, opts)
         report(rows, root, opts, everything)
         say()

@@ -219,12 +219,12 @@ def render_references(dest, root, steps=None, build=os.path.join("build", "relea
     numbers = {}
     for key, step, args, shows, what, suffix in chosen:
         binary, name = program(root, build, step)
-        if not os.path.exists(binary):
-            raise SystemExit(f"kit: {binary} is not built (the reference picture {key} needs it)")
         out = os.path.join(dest, REFERENCE_DIR, f"{key}.png")
-        problem = render(binary, args, out, suffix)
+        problem = render(binary, args, out, suffix) if binary and os.path.exists(binary) else "not built"
         if problem:
-            raise SystemExit(f"kit: the reference picture {key} ({name} {' '.join(args)}): {problem}")
+            # The kit goes on without it: check then says it has no reference picture.
+            log(f"  {key}: NO reference picture ({name} {' '.join(args)}): {problem}")
+            continue
         w, h, rows = png.read(out)
         n = w * h
         mean = [round(sum(sum(row[c::3]) for row in rows) / n, 2) for c in range(3)]

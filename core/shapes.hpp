@@ -1,6 +1,7 @@
 // Spheres and planes, and their ray intersections: the analytic shapes of the lecture.
 #pragma once
 
+#include <cmath>
 #include <optional>
 
 #include "core/ray.hpp"
@@ -20,22 +21,15 @@ struct PlaneT {
     T d = T(0);
 };
 
-// t = -(O.N + d) / (D.N), any sign; nothing when the ray is parallel to the plane
-// (including a ray that lies in the plane: no single point).
+// The renderer's planes (the scenes' floors): the nearest hit inside [tmin, tmax], nothing
+// when the ray is parallel. The general ray/plane distance, any sign, is exercise 1.2's
+// (step 01), which the core does not give away.
 template <typename T>
-std::optional<T> rayPlaneT(const RayT<T>& ray, const PlaneT<T>& plane) {
+std::optional<T> intersectPlane(const RayT<T>& ray, const PlaneT<T>& plane) {
     T denom = glm::dot(ray.direction, plane.normal);
     if (denom == T(0)) return std::nullopt;
     T t = -(glm::dot(ray.origin, plane.normal) + plane.d) / denom;
-    if (!std::isfinite(t)) return std::nullopt;
-    return t;
-}
-
-// Nearest plane hit inside [tmin, tmax].
-template <typename T>
-std::optional<T> intersectPlane(const RayT<T>& ray, const PlaneT<T>& plane) {
-    auto t = rayPlaneT(ray, plane);
-    if (t && *t >= ray.tmin && *t <= ray.tmax) return t;
+    if (std::isfinite(t) && t >= ray.tmin && t <= ray.tmax) return t;
     return std::nullopt;
 }
 

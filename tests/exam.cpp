@@ -92,7 +92,8 @@ TEST_SUITE("exam") {
         REQUIRE(t.has_value());
         checkVec(ray.at(*t), Vec3d(5, 1, 5), 1e-14);
         // -x - z = 10: t = -6, behind the eye, so no hit for t >= 0.
-        CHECK(*rayPlaneT(ray, PlaneT<double>{{-1, 0, -1}, -10}) == doctest::Approx(-6.0));
+        Rayd line({1, 1, 1}, {1, 0, 1}, -kInfinity<double>, kInfinity<double>);
+        CHECK(*intersectPlane(line, PlaneT<double>{{-1, 0, -1}, -10}) == doctest::Approx(-6.0));
         CHECK_FALSE(intersectPlane(ray, PlaneT<double>{{-1, 0, -1}, -10}).has_value());
     }
     TEST_CASE("exam: ray/sphere from outside: entry point and outward normal") {

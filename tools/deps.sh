@@ -1,6 +1,6 @@
 #!/usr/bin/env bash
 # Installs the Debian packages a workbook command needs, when they are missing.
-# usage: tools/deps.sh GROUP...   (groups: build test report slides fuzz grade bench)
+# usage: tools/deps.sh GROUP...   (groups: build test report slides fuzz grade bench watch)
 # As root it runs apt-get; otherwise it prints the exact apt-get line and exits 1.
 # The group slides also installs the slides' npm packages (Marp, playwright-core) with
 # `npm ci --prefix slides` from slides/package-lock.json when they are missing or stale.
@@ -16,6 +16,7 @@ pkgs_for() {
     ;;
   test) echo python3 python3-yaml xvfb xauth ;; # xvfb: the windows' X11 + GLX test
   report) echo python3 python3-matplotlib ;;
+  watch) echo inotify-tools ;; # ./workbook check --watch (it polls without)
   slides)
     echo chromium
     command -v node >/dev/null 2>&1 || echo nodejs npm # Debian's Node.js only when none is installed

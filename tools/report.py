@@ -16,12 +16,44 @@ matplotlib.use("Agg")
 import matplotlib.pyplot as plt  # noqa: E402
 
 from .grading import ROOT  # noqa: E402
-from .grading.exercises import exercises as marked_exercises, suite_results  # noqa: E402
+from .check import classify, parse_cases  # noqa: E402
+from .grading.exercises import MAX_RESULT_BYTES, exercises as marked_exercises  # noqa: E402
 
 
 def exercises():
     """(id, title, points, file) for every exercise marker in the steps' sources."""
     return [(e.id, e.title, e.points, e.path) for e in marked_exercises(ROOT)]
+
+
+def suite_cases(out):
+    """{suite name: its test cases} over the test_*.xml files in a folder (check's parse)."""
+    by_suite = {}
+    for path in sorted(glob.glob(os.path.join(out, "test_*.xml"))):
+        try:
+            with open(path, "rb") as f:
+                data = f.read(MAX_RESULT_BYTES)
+        except OSError:
+            continue
+        for c in parse_cases(data) or []:
+            by_suite.setdefault(c["suite"], []).append(c)
+    return by_suite
+
+
+def checked_time(out):
+    try:
+        with open(os.path.join(out, "check", "status.json"), encoding="utf-8") as f:
+            return json.load(f).get("time", "")
+    except (OSError, ValueError, AttributeError):
+        return ""
+
+
+def check_status(out):
+    """out/check/status.json (written by ./workbook check): {exercise: its entry}."""
+    try:
+        with open(os.path.join(out, "check", "status.json"), encoding="utf-8") as f:
+            return {e["id"]: e for e in json.load(f).get("exercises", [])}
+    except (OSError, ValueError, KeyError, TypeError):
+        return {}
 
 
 def table_html(t):
@@ -118,27 +150,41 @@ def main():
     for path in sorted(glob.glob(os.path.join(out, "[0-9][0-9]_*.json"))):
         with open(path, encoding="utf-8") as f:
             reports.append(json.load(f))
-    results = suite_results(out)
+    by_suite = suite_cases(out)
+    checked = check_status(out)
     parts = []
     # Every step report names its machine; reports copied together from two machines say so.
     machines = sorted({r.get("machine", "an unknown machine") for r in reports})
     machine = " and ".join(machines) if machines else "an unknown machine"
-    # Exercise status.
+    # Exercise status, in the words of ./workbook check (not started, needs N.M, ...).
     rows = []
     total = earned = 0
     for ex, title, points, src in exercises():
-        passed, failed = results.get(f"exercise {ex}", (0, 0))
-        status = "passed" if passed and not failed else ("failed" if failed else "not run")
+        cases = by_suite.get(f"exercise {ex}", [])
+        status = classify(ex, cases)[0] if cases else "not run"
+        passed = sum(c["passed"] for c in cases)
         total += points
         earned += points if status == "passed" else 0
+        css = {"passed": "passed", "failed": "failed", "not started": "notstarted"}.get(status, "other")
+        picture = ""
+        entry = checked.get(ex)
+        if entry and os.path.exists(os.path.join(out, "check", f"{ex}.png")):
+            picture = (f"<a href='check/{ex}.png' title='{html.escape(entry.get('picture') or '')}'>"
+                       f"picture</a> <span class=note>({html.escape(entry['status'])} at "
+                       f"{html.escape(str(checked_time(out)))})</span>")
+        elif entry and entry.get("picture"):
+            picture = f"<span class=note>{html.escape(entry['picture'])}</span>"
         rows.append(
-            f"<tr class={status.replace(' ', '')}><td>{ex}</td><td>{html.escape(title)}</td>"
-            f"<td>{points}</td><td>{passed}/{passed + failed}</td><td>{status}</td><td><code>{src}</code></td></tr>"
+            f"<tr class={css}><td>{ex}</td><td>{html.escape(title)}</td>"
+            f"<td>{points}</td><td>{passed}/{len(cases)}</td><td>{html.escape(status)}</td>"
+            f"<td><code>{src}</code></td><td>{picture}</td></tr>"
         )
     parts.append(
         f"<h2 id=exercises>Exercises: {earned} of {total} points pass</h2>"
+        "<p class=note>The same status as <code>./workbook check</code>; its pictures (yours, the "
+        "reference, the pixels that differ) from its last run, out/check/.</p>"
         "<table><tr><th>exercise</th><th>what</th><th>points</th><th>test cases passed</th>"
-        "<th>status</th><th>source</th></tr>" + "".join(rows) + "</table>"
+        "<th>status</th><th>source</th><th>check's picture</th></tr>" + "".join(rows) + "</table>"
     )
     for r in reports:
         prog = r["program"]
@@ -167,7 +213,7 @@ def main():
     page = f"""<!doctype html><html><head><meta charset=utf-8><title>Boxes workbook: the tour</title>
 <style>body{{font-family:sans-serif;max-width:1100px;margin:2em auto;color:#222}}
 table{{border-collapse:collapse;margin:.5em 0;font-size:90%}}td,th{{border:1px solid #ccc;padding:2px 8px;text-align:left}}td.num{{text-align:right}}
-tr.passed td{{background:#e8f6e8}}tr.failed td{{background:#fbe3e3}}
+tr.passed td{{background:#e8f6e8}}tr.failed td{{background:#fbe3e3}}tr.notstarted td{{color:#777}}
 figure{{display:inline-block;margin:.5em}}img{{max-width:640px;border:1px solid #ddd}}.note{{color:#666;font-size:85%}}</style></head>
 <body><h1>Boxes workbook: the tour</h1><p>Measured on {html.escape(machine)}. <a href='#exercises'>Exercises</a> | {nav}</p>{slides}
 {''.join(parts)}</body></html>"""

@@ -23,6 +23,7 @@ TriangleTest parseTest(const std::string& name) {
 int main(int argc, char** argv) {
     std::string testName = "watertight";
     bool measure = false;
+    bool flat = false;
     size_t crackRays = 100000;
     TriangleTest test = TriangleTest::Watertight;
     std::shared_ptr<TriangleGrid> grid;  // the scene's mesh; none for a scene without one
@@ -39,6 +40,8 @@ int main(int argc, char** argv) {
             ->check(CLI::IsMember({"plane", "mt", "watertight"}))
             ->capture_default_str();
         app.add_flag("--measure", measure, "also measure speed and cracks and print the tables");
+        app.add_flag("--flat", flat,
+                     "shade with the triangles' own normals, without interpolation (exercise 1.6)");
         app.add_option("--crack-rays", crackRays, "rays per mesh and feature for the crack count")
             ->check(CLI::Range(size_t(1), size_t(10000000)));
     };
@@ -47,6 +50,7 @@ int main(int argc, char** argv) {
         test = parseTest(testName);
         if (!run.scene.hasMesh()) return;
         grid = std::make_shared<TriangleGrid>(run.scene.mesh, run.scene.meshMaterial, test);
+        grid->setSmoothShading(!flat);
         run.scene.geometries.push_back(grid);
     };
     step.caption = [&](const StepRun& run) {

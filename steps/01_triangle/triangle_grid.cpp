@@ -154,8 +154,9 @@ bool TriangleGrid::intersect(const Ray& ray, SurfaceHit& hit) const {
     hit.geometricNormal = len > 0.0f ? n / len : Vec3(0, 1, 0);
     hit.u = h ? h->u : 0.0f;
     hit.v = h ? h->v : 0.0f;
-    hit.shadingNormal = interpolateNormal(mesh_.normals[idx[0]], mesh_.normals[idx[1]],
-                                          mesh_.normals[idx[2]], hit.u, hit.v);
+    hit.shadingNormal = smooth_ ? interpolateNormal(mesh_.normals[idx[0]], mesh_.normals[idx[1]],
+                                                    mesh_.normals[idx[2]], hit.u, hit.v)
+                                : hit.geometricNormal;
     hit.material = material_;
     hit.primitive = tri;
     hit.kind = SurfaceHit::Kind::Triangle;

@@ -18,6 +18,9 @@ public:
 
     void setTest(TriangleTest test) { test_ = test; }
     TriangleTest test() const { return test_; }
+    // Off: shade with each triangle's own normal (no interpolation, exercise 1.6), so a
+    // picture shows the hit test alone.
+    void setSmoothShading(bool smooth) { smooth_ = smooth; }
 
     bool intersect(const Ray& ray, SurfaceHit& hit) const override;
     bool occluded(const Ray& ray) const override;
@@ -39,6 +42,7 @@ private:
     const Mesh& mesh_;
     int material_;
     TriangleTest test_;
+    bool smooth_ = true;
     Vec3 lo_, hi_, cellSize_;
     glm::ivec3 res_;
     std::vector<uint32_t> cellStart_;  // prefix sums into cellTriangles_

@@ -107,6 +107,12 @@ class KitContents(unittest.TestCase):
         for module in ("kit", "exercises", "classroom", "sandbox", "submissions", "__init__"):
             self.assertNotIn(f"tools/grading/{module}.py", kit.NOT_IN_KIT)
         self.assertIn("tests/grading_test.py", kit.NOT_IN_KIT)
+        # The student's check ships in the kit (its end-to-end test, which uses the
+        # solutions, does not).
+        for path in ("tools/check.py", "tools/pictures.py", "tools/png.py",
+                     "tests/hints/exercises.json", "tests/hints/mistakes.json"):
+            self.assertNotIn(path, kit.NOT_IN_KIT)
+        self.assertIn("tests/check_test.py", kit.NOT_IN_KIT)
 
     def test_tracked_files_outside_git_skip_build_output(self):
         root = tempfile.mkdtemp()

@@ -2,7 +2,10 @@
 output) with every solution block replaced by a stub that throws NotImplemented("N.M").
 The grader (GRADER below, and its tests) stays out of the kit: it needs the solutions.
 
-usage: ./workbook kit DIR        (python3 -m tools.grading.kit DIR, from the repository root)
+usage: ./workbook kit DIR [--no-pictures]   (python3 -m tools.grading.kit DIR, from the root)
+
+The kit also gets the reference pictures of `./workbook check` (tools/pictures.py renders
+them with this tree's programs, the solutions): pictures and numbers, never code.
 
 Nothing between the markers survives: the kit's file is the reference file with each
 block's lines (from BEGIN SOLUTION to END SOLUTION, both included) replaced by the stub, and
@@ -23,7 +26,7 @@ SKIP_DIRS = {".git", "build", "out", "kit", "node_modules", "__pycache__"}
 # solutions). Their end-to-end tests and unit tests stay out with them.
 GRADER = ("grade", "grade_class", "gradescope", "class_bench")
 NOT_IN_KIT = ({f"tools/grading/{m}.py" for m in GRADER} | {f"tests/tools/test_{m}.py" for m in GRADER}
-              | {"tests/grading_test.py", "tests/class_grading_test.py"})
+              | {"tests/grading_test.py", "tests/class_grading_test.py", "tests/check_test.py"})
 CLASSROOM_WORKFLOW = ".github/workflows/classroom.yml"  # GitHub Classroom (classroom.py)
 
 
@@ -129,17 +132,23 @@ def write_kit(dest, root=ROOT):
 
 
 def main(argv):
-    if len(argv) != 1 or argv[0].startswith("-"):
-        print("usage: ./workbook kit DIR   (writes the starter kit into the new folder DIR)",
-              file=sys.stderr)
+    pictures = "--no-pictures" not in argv
+    args = [a for a in argv if a != "--no-pictures"]
+    if len(args) != 1 or args[0].startswith("-"):
+        print("usage: ./workbook kit DIR [--no-pictures]   (writes the starter kit into the new "
+              "folder DIR)", file=sys.stderr)
         return 2
-    stubbed = write_kit(argv[0])
+    stubbed = write_kit(args[0])
     points = sum(e.points for e in stubbed)
-    print(f"[workbook] starter kit in {argv[0]}: {len(stubbed)} exercises ({points} points) "
+    print(f"[workbook] starter kit in {args[0]}: {len(stubbed)} exercises ({points} points) "
           "replaced by stubs that throw NotImplemented", file=sys.stderr)
     for e in sorted(stubbed, key=lambda e: e.key):
         print(f"  {e.id:>5}  {e.points} pt  {e.path}  {e.title}", file=sys.stderr)
-    print(f"[workbook] build and test it with: cd {argv[0]} && ./workbook test", file=sys.stderr)
+    if pictures:
+        from ..pictures import render_references  # noqa: PLC0415
+
+        render_references(args[0], ROOT, log=lambda t: print(t, file=sys.stderr))
+    print(f"[workbook] the student's loop in it: cd {args[0]} && ./workbook check", file=sys.stderr)
     return 0
 
 

@@ -1,0 +1,150 @@
+"""Unit tests of the student's check (tools/check.py), its pictures (tools/pictures.py) and
+the PNG reader (tools/png.py): no build, no test program."""
+import json
+import os
+import re
+import sys
+import tempfile
+import unittest
+
+ROOT = os.path.dirname(os.path.dirname(os.path.dirname(os.path.abspath(__file__))))
+sys.path.insert(0, ROOT)
+from tools import check, pictures, png  # noqa: E402
+from tools.grading.exercises import exercises  # noqa: E402
+
+
+def xml(*cases):
+    body = "".join(cases)
+    return f'<doctest><TestSuite name="exercise 1.4">{body}</TestSuite></doctest>'.encode()
+
+
+def case(name, failures=0, inner=""):
+    return (f'<TestCase name="{name}" filename="/x/tests/step01_triangle.cpp" line="12">{inner}'
+            f'<OverallResultsAsserts successes="1" failures="{failures}" '
+            f'test_case_success="{"false" if failures else "true"}"/></TestCase>')
+
+
+def stub_exception(ex):
+    return f'<Exception crash="false">exercise {ex} is not implemented yet</Exception>'
+
+
+FAILED_CHECK = ('<Expression success="false" type="CHECK" filename="/x/tests/step01_triangle.cpp" '
+                'line="40"><Original>!hit.has_value()</Original><Expanded>false</Expanded>'
+                '<Info>ray O (0, 0, -1) D (0.9, 0.9, 1)</Info></Expression>')
+
+
+class Classify(unittest.TestCase):
+    def test_all_passing_is_passed(self):
+        self.assertEqual(check.classify("1.4", check.parse_cases(xml(case("a"), case("b"))))[0], "passed")
+
+    def test_own_stub_is_not_started_not_a_failure(self):
+        cases = check.parse_cases(xml(case("a", 1, stub_exception("1.4")), case("b", 1, stub_exception("1.4"))))
+        self.assertEqual(check.classify("1.4", cases)[0], "not started")
+
+    def test_an_earlier_stub_names_the_exercise_needed(self):
+        cases = check.parse_cases(xml(case("a", 1, stub_exception("1.1")), case("b")))
+        self.assertEqual(check.classify("1.4", cases)[0], "needs 1.1")
+
+    def test_a_wrong_answer_is_failed_with_its_check(self):
+        cases = check.parse_cases(xml(case("a"), case("past the second edge", 1, FAILED_CHECK)))
+        status, first = check.classify("1.4", cases)
+        self.assertEqual(status, "failed")
+        self.assertEqual(first["name"], "past the second edge")
+        self.assertEqual(first["failure"]["expression"], "!hit.has_value()")
+        self.assertEqual(first["failure"]["infos"], ["ray O (0, 0, -1) D (0.9, 0.9, 1)"])
+
+    def test_no_cases_is_no_tests(self):
+        self.assertEqual(check.classify("1.4", [])[0], "no tests")
+
+    def test_unreadable_results_are_none(self):
+        self.assertIsNone(check.parse_cases(b"<doctest><TestSuite"))
+
+
+class Words(unittest.TestCase):
+    def test_plain_words_name_the_case_the_check_the_values_and_the_input(self):
+        cases = check.parse_cases(xml(case("past the second edge", 1, FAILED_CHECK)))
+        row = {"id": "1.4", "status": "failed", "case": check.classify("1.4", cases)[1]}
+        text = "\n".join(check.describe_failure(row, "/x"))
+        self.assertIn('"past the second edge"', text)
+        self.assertIn("CHECK( !hit.has_value() ) failed at tests/step01_triangle.cpp:40", text)
+        self.assertIn("with the values: false", text)
+        self.assertIn("input: ray O (0, 0, -1)", text)
+
+    def test_compile_errors_relative_to_the_tree(self):
+        out = "FAILED: x.o\n../../steps/01_triangle/triangle.cpp:60:5: error: 'foo' was not declared\n"
+        self.assertEqual(check.first_compile_error(out, "/r"),
+                         "steps/01_triangle/triangle.cpp:60: 'foo' was not declared")
+
+
+class Selection(unittest.TestCase):
+    def setUp(self):
+        self.all = exercises(ROOT)
+
+    def test_one_exercise_one_step_and_everything(self):
+        self.assertEqual([e.id for e in check.select(self.all, ["1.4"])], ["1.4"])
+        self.assertEqual([e.id for e in check.select(self.all, ["01"])], [e.id for e in self.all if e.step == 1])
+        self.assertEqual(len(check.select(self.all, [])), len(self.all))
+
+    def test_in_order_whatever_the_order_asked(self):
+        self.assertEqual([e.id for e in check.select(self.all, ["1.5", "1.2"])], ["1.2", "1.5"])
+
+    def test_unknown_names_are_refused(self):
+        for bad in ("9.9", "1.44", "99", "x"):
+            with self.assertRaises(ValueError):
+                check.select(self.all, [bad])
+
+
+class Hints(unittest.TestCase):
+    def test_every_exercise_has_a_short_hint(self):
+        generic, mistakes = check.load_hints(ROOT)
+        self.assertIsInstance(mistakes, dict)
+        for e in exercises(ROOT):
+            hint = generic.get(e.id, "")
+            self.assertTrue(hint, f"exercise {e.id} has no hint in tests/hints/exercises.json")
+            sentences = len(re.findall(r"[.!?](\s|$)", hint))
+            self.assertIn(sentences, (1, 2), f"exercise {e.id}: one or two sentences")
+
+    def test_a_catalogued_mistake_replaces_the_generic_hint(self):
+        hints = ({"1.4": "generic"}, {"past the second edge": {"exercise": "1.4", "hint": "check v"}})
+        row = {"id": "1.4", "case": {"name": "past the second edge"}}
+        self.assertEqual(check.hint_for(row, hints), ("check v", True))
+        row = {"id": "1.4", "case": {"name": "another case"}}
+        self.assertEqual(check.hint_for(row, hints), ("generic", False))
+        # A mistake of another exercise does not apply.
+        row = {"id": "1.5", "case": {"name": "past the second edge"}}
+        self.assertEqual(check.hint_for(row, ({"1.5": "g5"}, hints[1])), ("g5", False))
+
+
+class Pictures(unittest.TestCase):
+    def test_every_exercise_has_a_picture_or_says_why_not(self):
+        ids = {e.id for e in exercises(ROOT)}
+        with_picture = {i for p in pictures.PICTURES for i in p[3]}
+        self.assertLessEqual(with_picture, ids)
+        self.assertLessEqual(set(pictures.NOT_SHOWN), ids - with_picture)
+
+    def test_png_round_trip_and_the_difference_count(self):
+        with tempfile.TemporaryDirectory() as tmp:
+            a, b, out = (os.path.join(tmp, n) for n in ("a.png", "b.png", "c.png"))
+            rows = [bytearray([10, 20, 30] * 5) for _ in range(4)]
+            png.write(a, 5, 4, rows)
+            self.assertEqual(png.read(a), (5, 4, rows))
+            changed = [bytearray(r) for r in rows]
+            changed[1][0:3] = b"\xff\xff\xff"  # one pixel far off
+            changed[2][3:6] = bytes([12, 22, 32])  # within the tolerance
+            png.write(b, 5, 4, changed)
+            self.assertEqual(pictures.compare(b, a, out), 1)
+            w, h, composite = png.read(out)
+            self.assertEqual((w, h), (3 * 5 + 8, 4))
+            x = 2 * 5 + 8  # the differences panel
+            self.assertEqual(tuple(composite[1][3 * x : 3 * x + 3]), pictures.MARK)
+
+    def test_not_a_png_is_one_clear_error(self):
+        with tempfile.NamedTemporaryFile(suffix=".png") as f:
+            f.write(b"hello")
+            f.flush()
+            with self.assertRaises(png.PngError):
+                png.read(f.name)
+
+
+if __name__ == "__main__":
+    unittest.main()

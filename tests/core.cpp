@@ -20,7 +20,7 @@
 using namespace boxes;
 
 TEST_SUITE("core") {
-    TEST_CASE("test support: GLM vectors print as (x, y, z) in failure messages") {
+    TEST_CASE("test support: GLM vectors print as (x y z) with commas in failure messages") {
         CHECK(doctest::toString(Vec3(1.0f, 2.5f, -3.0f)) == "(1, 2.5, -3)");
         CHECK(doctest::toString(Vec3d(0.1, 0, 0)) == "(0.10000000000000001, 0, 0)");
         CHECK(doctest::toString(glm::ivec2(4, -7)) == "(4, -7)");

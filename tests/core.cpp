@@ -20,6 +20,14 @@
 using namespace boxes;
 
 TEST_SUITE("core") {
+    TEST_CASE("test support: GLM vectors print as (x y z) with commas in failure messages") {
+        CHECK(doctest::toString(Vec3(1.0f, 2.5f, -3.0f)) == "(1, 2.5, -3)");
+        CHECK(doctest::toString(Vec3d(0.1, 0, 0)) == "(0.10000000000000001, 0, 0)");
+        CHECK(doctest::toString(glm::ivec2(4, -7)) == "(4, -7)");
+        // A name passed to INFO as a string, not as a pointer.
+        const char* name = "sh1";
+        CHECK(doctest::toString(std::string(name)) == "sh1");
+    }
     TEST_CASE("image: PNG round trip keeps size and 8-bit values") {
         test::TempDir dir;
         Image img(5, 3);
@@ -221,7 +229,7 @@ TEST_SUITE("renderer") {
     TEST_CASE("effects on demand: every scene kind renders the identical image with fewer rays") {
         for (const char* name :
              {"spheres", "diffuse", "mirrors", "glass", "single-sphere", "small-lights"}) {
-            INFO(name);
+            INFO(std::string(name));
             Scene scene = makeScene(name, SceneOptions{test::dataDir(), 4.0f / 3.0f});
             auto c = test::renderBothWays(scene, 40, 30, 4);
             CHECK(c.identical);

@@ -87,7 +87,7 @@ TEST_SUITE("exam practice") {
     }
     TEST_CASE("answer parser: what it cannot read is named") {
         for (const char* bad : {"1 +", "sqrt(-1)", "(1, 2", "1 ) 2", "foo", "1 # 2", "1/0", "1,"}) {
-            INFO(bad);
+            INFO(std::string(bad));
             CHECK_THROWS_AS(parseNumberList(bad), std::invalid_argument);
         }
         CHECK_THROWS_AS(evaluateExpression("1 2"), std::invalid_argument);

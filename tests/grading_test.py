@@ -158,6 +158,9 @@ def scenario_kit(work):
     check(not os.path.exists(os.path.join(dest, "build")), "no build output in the kit")
     check(not any(os.path.exists(os.path.join(dest, rel)) for rel in NOT_IN_KIT) and
           not os.path.exists(os.path.join(dest, "tools", "grading", "grade.py")), "no grader in the kit")
+    check(not os.path.exists(os.path.join(dest, "tests", "mutants")) and
+          os.path.isfile(os.path.join(dest, "tests", "hints", "mistakes.json")),
+          "no mistakes' patches in the kit (their hints are)")
 
 
 def scenario_reference(work):

@@ -284,7 +284,7 @@ TEST_SUITE("hard cases reliability") {
         Mesh many = one;
         many.triangles.assign(1000000, one.triangles[0]);
         for (BvhBuilder b : {BvhBuilder::BinnedSah, BvhBuilder::Midpoint}) {
-            INFO(bvhBuilderName(b));
+            INFO(std::string(bvhBuilderName(b)));
             BvhBuildOptions options;
             options.builder = b;
             BvhBuildStats stats;

@@ -51,6 +51,23 @@ TEST_SUITE("exercise 1.1") {
         checkVec(q->normal, Vec3(s), 1e-6);
         CHECK(q->d == doctest::Approx(-s).epsilon(1e-6));
     }
+    TEST_CASE("triangle plane: d puts the triangle's own vertices on the plane") {
+        // N.P + d = 0 at every vertex, for a plane away from the origin.
+        const Triangled t{{1, 0, 2}, {3, 1, 2}, {0, 4, 5}};
+        auto p = trianglePlane(t);
+        REQUIRE(p.has_value());
+        for (const Vec3d& v : {t.a, t.b, t.c}) {
+            INFO("vertex " << v);
+            CHECK(std::abs(glm::dot(p->normal, v) + p->d) < 1e-12);
+        }
+    }
+    TEST_CASE("triangle plane: the normal has unit length") {
+        // The cross product of these edges is (0, 0, 6): divided by its length.
+        auto p = trianglePlane(Triangled{{0, 0, 2}, {2, 0, 2}, {0, 3, 2}});
+        REQUIRE(p.has_value());
+        checkVec(p->normal, Vec3d(0, 0, 1), 1e-15);
+        CHECK(p->d == doctest::Approx(-2.0));
+    }
     TEST_CASE("hard case: a degenerate triangle has no plane") {
         CHECK_FALSE(trianglePlane(Triangled{{0, 0, 0}, {1, 1, 1}, {2, 2, 2}}).has_value());
         CHECK_FALSE(trianglePlane(Triangled{{1, 2, 3}, {1, 2, 3}, {4, 5, 6}}).has_value());
@@ -86,7 +103,37 @@ TEST_SUITE("exercise 1.2") {
     }
 }
 
+TEST_SUITE("exercise 1.2") {
+    TEST_CASE("ray/plane distance: a plane behind the origin has a negative t") {
+        // The distance along the line, not a hit: z = 0 from (0, 0, 3) looking up is t = -3.
+        auto t = rayPlaneDistance(Rayd({0, 0, 3}, {0, 0, 1}), PlaneT<double>{{0, 0, 1}, 0});
+        REQUIRE(t.has_value());
+        CHECK(*t == -3.0);
+    }
+}
+
 TEST_SUITE("exercise 1.3") {
+    TEST_CASE(
+        "inside test: a ray exactly through a shared edge is inside one of the two triangles") {
+        // Straight down onto points of the shared hypotenuse: that edge's volume is exactly
+        // zero, which is on the edge, inside.
+        const Triangle a = cast<float>(kUnit), b = cast<float>(kUnitNeighbour);
+        for (float s : {0.25f, 0.5f, 0.75f}) {
+            Ray ray(Vec3(1.0f - s, s, 1.0f), Vec3(0, 0, -1));
+            INFO("through " << ray.at(1.0f));
+            CHECK((insideEdgePlanes(ray, a) || insideEdgePlanes(ray, b)));
+        }
+    }
+    TEST_CASE("inside test: seen from either side of the triangle") {
+        // From above the three volumes are negative, from below positive: both inside.
+        for (double z : {1.0, -1.0}) {
+            INFO("origin at z = " << z);
+            auto uv = insideEdgePlanes(Rayd({0.5, 0.25, z}, {0, 0, -z}), kUnit);
+            REQUIRE(uv.has_value());
+            CHECK(uv->x == doctest::Approx(0.5));
+            CHECK(uv->y == doctest::Approx(0.25));
+        }
+    }
     TEST_CASE("inside test: barycentrics of a worked point") {
         // (0.25, 0.25, 1) straight down: the three edge volumes are -0.5, -0.25, -0.25.
         auto uv = insideEdgePlanes(Rayd({0.25, 0.25, 1}, {0, 0, -1}), kUnit);
@@ -122,7 +169,8 @@ TEST_SUITE("exercise 1.3") {
 // The three full tests must agree on these worked numbers.
 template <typename Real>
 void checkWorkedHits(TriangleTest test) {
-    INFO(std::string(triangleTestName(test)) << (sizeof(Real) == 4 ? " in float" : " in double"));
+    INFO(std::string(triangleTestName(test))
+         << std::string(sizeof(Real) == 4 ? " in float" : " in double"));
     RayT<Real> down({Real(0.2), Real(0.3), Real(2)}, {0, 0, -1});
     auto h = intersectTriangle(test, down, cast<Real>(kUnit));
     REQUIRE(h.has_value());
@@ -216,6 +264,44 @@ TEST_SUITE("exercise 1.4") {
     TEST_CASE("Moller-Trumbore: hard cases") {
         checkHardCases(TriangleTest::MollerTrumbore);
     }
+    TEST_CASE("Moller-Trumbore: a point past the first edge (u < 0) is a miss") {
+        // Straight down at (-0.2, 0.5): u = -0.2, v = 0.5, u + v <= 1.
+        CHECK_FALSE(intersectMollerTrumbore(Rayd({-0.2, 0.5, 1}, {0, 0, -1}), kUnit));
+        CHECK_FALSE(intersectMollerTrumbore(Ray({-0.2f, 0.5f, 1}, {0, 0, -1}), cast<float>(kUnit)));
+    }
+    TEST_CASE("Moller-Trumbore: a point past the second edge (v < 0) is a miss") {
+        // Straight down at (0.5, -0.2): u = 0.5, v = -0.2, u + v <= 1.
+        CHECK_FALSE(intersectMollerTrumbore(Rayd({0.5, -0.2, 1}, {0, 0, -1}), kUnit));
+        CHECK_FALSE(intersectMollerTrumbore(Ray({0.5f, -0.2f, 1}, {0, 0, -1}), cast<float>(kUnit)));
+    }
+    TEST_CASE("Moller-Trumbore: a point past the third edge (u + v > 1) is a miss") {
+        // Straight down at (0.6, 0.6): u and v in [0, 1], u + v = 1.2.
+        CHECK_FALSE(intersectMollerTrumbore(Rayd({0.6, 0.6, 1}, {0, 0, -1}), kUnit));
+        CHECK_FALSE(intersectMollerTrumbore(Ray({0.6f, 0.6f, 1}, {0, 0, -1}), cast<float>(kUnit)));
+    }
+    TEST_CASE("Moller-Trumbore: a point on an edge (u = 0 or v = 0) is a hit") {
+        // The triangle is closed: (0, 0.5) has u = 0, (0.5, 0) has v = 0, exactly.
+        auto onU = intersectMollerTrumbore(Rayd({0, 0.5, 1}, {0, 0, -1}), kUnit);
+        REQUIRE(onU.has_value());
+        CHECK(onU->u == 0.0);
+        auto onV = intersectMollerTrumbore(Rayd({0.5, 0, 1}, {0, 0, -1}), kUnit);
+        REQUIRE(onV.has_value());
+        CHECK(onV->v == 0.0);
+    }
+    TEST_CASE("Moller-Trumbore: the back of the triangle is hit too (no culling)") {
+        // From below, against the winding: det < 0, and still t = 2, u = 0.2, v = 0.3.
+        auto h = intersectMollerTrumbore(Rayd({0.2, 0.3, -2}, {0, 0, 1}), kUnit);
+        REQUIRE(h.has_value());
+        CHECK(h->t == doctest::Approx(2.0));
+        CHECK(h->u == doctest::Approx(0.2));
+        CHECK(h->v == doctest::Approx(0.3));
+    }
+    TEST_CASE("Moller-Trumbore: a triangle behind the origin (t < tmin) is a miss") {
+        // The line meets the triangle at t = -1.
+        CHECK_FALSE(intersectMollerTrumbore(Rayd({0.2, 0.2, -1}, {0, 0, -1}), kUnit));
+        // A segment starting past the triangle: t = 2 < tmin = 3.
+        CHECK_FALSE(intersectMollerTrumbore(Rayd({0.2, 0.2, 2}, {0, 0, -1}, 3.0), kUnit));
+    }
 }
 
 TEST_SUITE("exercise 1.5") {
@@ -225,6 +311,41 @@ TEST_SUITE("exercise 1.5") {
     }
     TEST_CASE("watertight: hard cases") {
         checkHardCases(TriangleTest::Watertight);
+    }
+    TEST_CASE("watertight: the back of the triangle is hit too (no culling)") {
+        // From below the edge functions are all negative: still a hit, t = 2.
+        auto h = intersectWatertight(Rayd({0.2, 0.3, -2}, {0, 0, 1}), kUnit);
+        REQUIRE(h.has_value());
+        CHECK(h->t == doctest::Approx(2.0));
+        CHECK(h->u == doctest::Approx(0.2));
+        CHECK(h->v == doctest::Approx(0.3));
+        auto f = intersectWatertight(Ray({0.2f, 0.3f, -2}, {0, 0, 1}), cast<float>(kUnit));
+        CHECK(f.has_value());
+    }
+    TEST_CASE("watertight: a ray exactly through a shared edge hits one of the two triangles") {
+        // Points of the hypotenuse with exact float coordinates, straight down and slanted:
+        // the shared edge's function is exactly zero, which counts as inside.
+        const Triangle a = cast<float>(kUnit), b = cast<float>(kUnitNeighbour);
+        for (float s : {0.25f, 0.5f, 0.75f}) {
+            for (Vec3 d : {Vec3(0, 0, -1), Vec3(0.5f, 0.5f, -1), Vec3(-0.25f, -0.25f, -1)}) {
+                Vec3 target(1.0f - s, s, 0.0f);
+                Ray ray(target - d, d);
+                INFO("target " << target << " direction " << d);
+                CHECK((intersectWatertight(ray, a) || intersectWatertight(ray, b)));
+            }
+        }
+    }
+    TEST_CASE("watertight: t for a direction that is not a unit vector") {
+        // D = (0, 0, -4) from z = 2 reaches the plane at t = 0.5; D = (1, 1, 2) from
+        // (-0.8, -0.7, -2) reaches (0.2, 0.3, 0) at t = 1.
+        auto h = intersectWatertight(Rayd({0.2, 0.3, 2}, {0, 0, -4}), kUnit);
+        REQUIRE(h.has_value());
+        CHECK(h->t == doctest::Approx(0.5));
+        auto g = intersectWatertight(Rayd({-0.8, -0.7, -2}, {1, 1, 2}), kUnit);
+        REQUIRE(g.has_value());
+        CHECK(g->t == doctest::Approx(1.0));
+        CHECK(g->u == doctest::Approx(0.2));
+        CHECK(g->v == doctest::Approx(0.3));
     }
 
     TEST_CASE("hard case: a ray through a shared edge hits at least one of the two triangles") {
@@ -408,6 +529,14 @@ TEST_SUITE("exercise 1.6") {
         checkVec(interpolateNormal(x, y, z, 0.0f, 1.0f), z, 1e-7);
         checkVec(interpolateNormal(x, y, z, 0.0f, 0.0f), x, 1e-7);
         CHECK(glm::length(interpolateNormal(x, y, z, 0.2f, 0.7f)) == doctest::Approx(1.0f));
+    }
+    TEST_CASE("normal interpolation: the result has unit length") {
+        // Halfway between two unit normals 90 degrees apart the blend is 0.707 long.
+        Vec3 x(1, 0, 0), y(0, 1, 0), z(0, 0, 1);
+        for (auto [u, v] : {std::pair{0.5f, 0.0f}, {0.5f, 0.5f}, {0.1f, 0.3f}, {0.3f, 0.3f}}) {
+            INFO("u = " << u << ", v = " << v);
+            CHECK(std::abs(glm::length(interpolateNormal(x, y, z, u, v)) - 1.0f) < 1e-6f);
+        }
     }
 }
 

@@ -45,7 +45,7 @@ std::optional<BoxHit<T>> hitWith(BoxMethod m, const RayT<T>& ray, const Oriented
 }
 
 void checkWorkedBoxHits(BoxMethod m) {
-    INFO(boxMethodName(m));
+    INFO(std::string(boxMethodName(m)));
     // From (-3, 0.5, 0) along +x into the unit cube: t = 2 through face 0 (-x), entering.
     auto h = hitWith(m, Rayd({-3, 0.5, 0}, {1, 0, 0}), unitCube());
     REQUIRE(h.has_value());
@@ -78,7 +78,7 @@ void checkWorkedBoxHits(BoxMethod m) {
 }
 
 void checkBoxHardCases(BoxMethod m) {
-    INFO(boxMethodName(m));
+    INFO(std::string(boxMethodName(m)));
     SUBCASE("hard case: origin inside the box reports the exit face") {
         auto h = hitWith(m, Rayd({0, 0, 0}, {1, 0, 0}), unitCube());
         REQUIRE(h.has_value());
@@ -165,6 +165,30 @@ TEST_SUITE("exercise 2.1") {
     }
 }
 
+TEST_SUITE("exercise 2.1") {
+    // The box with centre (1, 2, 3), half extents (1, 2, 3) along x, y and z.
+    const OrientedBoxd kBox = OrientedBoxd::axisAligned(Bounds3d({0, 0, 0}, {2, 4, 6}));
+    TEST_CASE("face planes: every face passes through the centre plus or minus its half extent") {
+        auto p = boxFacePlanes(kBox);
+        for (int f = 0; f < 6; ++f) {
+            int k = f / 2;
+            Vec3d onFace =
+                kBox.centre + (f % 2 ? 1.0 : -1.0) * kBox.halfExtents[k] * kBox.axes[size_t(k)];
+            INFO("face " << f << " at " << onFace);
+            CHECK(std::abs(glm::dot(p[size_t(f)].normal, onFace) + p[size_t(f)].d) < 1e-12);
+        }
+    }
+    TEST_CASE("face planes: each axis has its own half extent") {
+        // The centre lies h_k inside face 2k and face 2k + 1: N.c + d = -h_k.
+        auto p = boxFacePlanes(kBox);
+        for (int f = 0; f < 6; ++f) {
+            INFO("face " << f);
+            CHECK(glm::dot(p[size_t(f)].normal, kBox.centre) + p[size_t(f)].d ==
+                  doctest::Approx(-kBox.halfExtents[f / 2]));
+        }
+    }
+}
+
 TEST_SUITE("exercise 2.2") {
     TEST_CASE("six planes: worked hits") {
         checkWorkedBoxHits(BoxMethod::SixPlanes);
@@ -187,6 +211,34 @@ TEST_SUITE("exercise 2.2") {
         CHECK(h->t == 1.0);
         CHECK(h->entering);
     }
+    TEST_CASE("six planes: the nearest of the entry and exit faces") {
+        // Along +x the exit face (1, t = 4) is tested after the entry face (0, t = 2).
+        auto h = intersectSixPlanes(Rayd({-3, 0.5, 0.25}, {1, 0, 0}), planesOf(unitCube()));
+        REQUIRE(h.has_value());
+        CHECK(h->t == doctest::Approx(2.0));
+        CHECK(h->face == 0);
+    }
+    TEST_CASE("six planes: a hit on an edge of the box counts (closed box)") {
+        // (0, 2, 0) along (1, -1, 0) touches the edge x = 1, y = 1 at t = 1 and nothing else:
+        // the point lies on two planes, inside the closed box.
+        auto h = intersectSixPlanes(Rayd({0, 2, 0}, {1, -1, 0}), planesOf(unitCube()));
+        REQUIRE(h.has_value());
+        CHECK(h->t == doctest::Approx(1.0));
+    }
+    TEST_CASE("six planes: a box behind the ray is missed") {
+        // The faces lie at t = -4 and t = -2.
+        CHECK_FALSE(intersectSixPlanes(Rayd({3, 0, 0}, {1, 0, 0}), planesOf(unitCube())));
+    }
+    TEST_CASE("six planes: entering when the ray runs against the face's normal") {
+        auto in = intersectSixPlanes(Rayd({0.5, -3, 0}, {0, 1, 0}), planesOf(unitCube()));
+        REQUIRE(in.has_value());
+        CHECK(in->face == 2);
+        CHECK(in->entering);
+        auto out = intersectSixPlanes(Rayd({0.5, 0, 0}, {0, 1, 0}), planesOf(unitCube()));
+        REQUIRE(out.has_value());
+        CHECK(out->face == 3);
+        CHECK_FALSE(out->entering);
+    }
 }
 
 TEST_SUITE("exercise 2.3") {
@@ -195,6 +247,10 @@ TEST_SUITE("exercise 2.3") {
         CHECK(axisPlaneDistance(4.0, 1.0, 0.5) == 6.0);
         CHECK(axisPlaneDistance(-1.0, 3.0, -2.0) == 2.0);     // moving towards -x
         CHECK(axisPlaneDistance(1.0f, 3.0f, 2.0f) == -1.0f);  // behind: negative
+    }
+    TEST_CASE("axis-aligned plane distance: a direction component other than 1 scales t") {
+        CHECK(axisPlaneDistance(4.0, 0.0, 2.0) == 2.0);
+        CHECK(axisPlaneDistance(1.0, 4.0, -0.5) == 6.0);
     }
     TEST_CASE("hard case: zero direction component gives infinities or NaN") {
         CHECK(axisPlaneDistance(2.0, 0.0, 0.0) == kInfinity<double>);
@@ -229,6 +285,37 @@ TEST_SUITE("exercise 2.4") {
     }
     TEST_CASE("slabs: hard cases") {
         checkBoxHardCases(BoxMethod::Slabs);
+    }
+    TEST_CASE("slabs: a ray parallel to a slab and outside it misses") {
+        // Parallel to the y slab at y = 1.5 (and to z): it passes beside the cube.
+        CHECK_FALSE(intersectBoxSlabs(Rayd({-3, 1.5, 0}, {1, 0, 0}), unitCube()));
+        CHECK_FALSE(intersectBoxSlabs(Rayd({0.5, -1.5, -3}, {0, 0, 1}), unitCube()));
+    }
+    TEST_CASE("slabs: a ray along a negative axis enters through the high face") {
+        auto h = intersectBoxSlabs(Rayd({3, 0.5, 0}, {-1, 0, 0}), unitCube());
+        REQUIRE(h.has_value());
+        CHECK(h->t == doctest::Approx(2.0));
+        CHECK(h->face == 1);
+        CHECK(h->entering);
+    }
+    TEST_CASE("slabs: from inside the box the exit face is hit") {
+        auto h = intersectBoxSlabs(Rayd({0, 0.5, 0}, {0, 1, 0}), unitCube());
+        REQUIRE(h.has_value());
+        CHECK(h->t == doctest::Approx(0.5));
+        CHECK(h->face == 3);
+        CHECK_FALSE(h->entering);
+    }
+    TEST_CASE("slabs: the face entered along +x is the -x face") {
+        auto h = intersectBoxSlabs(Rayd({-3, 0.5, 0}, {1, 0, 0}), unitCube());
+        REQUIRE(h.has_value());
+        CHECK(h->face == 0);
+        checkVec(h->normal, Vec3d(-1, 0, 0), 1e-15);
+    }
+    TEST_CASE("slabs: a ray touching only an edge hits (entry equals exit)") {
+        // (0, 2, 0) along (1, -1, 0): x and y slabs give [-1, 1] and [1, 3], so entry = exit = 1.
+        auto h = intersectBoxSlabs(Rayd({0, 2, 0}, {1, -1, 0}), unitCube());
+        REQUIRE(h.has_value());
+        CHECK(h->t == 1.0);
     }
     TEST_CASE("hard case: a flat box of zero thickness is hit") {
         OrientedBoxd flat{{0, 0, 0}, {Vec3d(1, 0, 0), Vec3d(0, 1, 0), Vec3d(0, 0, 1)}, {1, 0, 1}};

@@ -67,6 +67,11 @@ void checkSlabHardCase(const std::string& name, Test test) {
                 // Float too, and along a face plane of a flat box.
                 Ray f(Vec3(float(plane), -1, 0.5f), Vec3(float(zero), 1, 0));
                 CHECK(test(f, kUnitBoxF).has_value());
+                // The NaN on the last axis (z), where no later axis can overwrite it.
+                auto z = test(Rayd({0.5, -1, plane}, {0, 1, zero}), kUnitBox);
+                REQUIRE(z.has_value());
+                CHECK(z->tnear == doctest::Approx(1.0));
+                CHECK(z->tfar == doctest::Approx(2.0).epsilon(1e-12));
             }
     } else if (name == "flat") {
         Bounds3d flat({0, 0, 0}, {1, 0, 1});  // the square y = 0
@@ -100,6 +105,12 @@ void checkSlabHardCase(const std::string& name, Test test) {
         CHECK(test(Rayd({2, 2, 2}, {-1, -1, -1}), kUnitBox).has_value());
         CHECK(test(Ray({2, 2, 2}, {-1, -1, -1}), kUnitBoxF).has_value());
         CHECK_FALSE(test(Rayd({2, 3.5, 0.5}, {-1, -1, 0}), kUnitBox));
+        // Touching only: the edge x = y = 1 at t = 1 and nothing else (tnear = tfar), and
+        // the corner (1, 1, 1) the same way.
+        auto edge = test(Rayd({0, 2, 0.5}, {1, -1, 0}), kUnitBox);
+        REQUIRE(edge.has_value());
+        CHECK(edge->tnear == 1.0);
+        CHECK(test(Rayd({0, 2, 2}, {1, -1, -1}), kUnitBox).has_value());
     }
 }
 
@@ -117,6 +128,10 @@ TEST_SUITE("exercise 3.1") {
         Bounds3d p = sphereBounds(SphereT<double>{{1, 1, 1}, 0.0});
         CHECK(p.min == p.max);
     }
+    TEST_CASE("sphere bounds: the box is twice the radius wide on every axis") {
+        Bounds3d b = sphereBounds(SphereT<double>{{0, 0, 0}, 3.0});
+        checkVec(b.diagonal(), Vec3d(6, 6, 6), 0.0);
+    }
 }
 
 TEST_SUITE("exercise 3.2") {
@@ -131,6 +146,11 @@ TEST_SUITE("exercise 3.2") {
         CHECK(f.max.z == 7.0f);
         CHECK_FALSE(f.isEmpty());
     }
+    TEST_CASE("triangle bounds: the third vertex can hold the minimum") {
+        Bounds3d b = triangleBounds(Triangled{{1, 1, 1}, {2, 2, 2}, {-1, -2, -3}});
+        checkVec(b.min, Vec3d(-1, -2, -3), 0.0);
+        checkVec(b.max, Vec3d(2, 2, 2), 0.0);
+    }
 }
 
 TEST_SUITE("exercise 3.3") {
@@ -143,6 +163,13 @@ TEST_SUITE("exercise 3.3") {
         Mesh sh1 = loadObj(test::dataDir() + "/meshes/sh1.obj");
         Bounds3f s = meshBounds(sh1);
         for (const Vec3& p : sh1.positions) CHECK(s.contains(p));
+    }
+    TEST_CASE("mesh bounds: every vertex of every triangle counts") {
+        // The extremes are the triangles' third vertices.
+        Mesh m = parseObj("v 0 0 0\nv 1 0 0\nv 0 1 5\nv 0 0 -4\nf 1 2 3\nf 1 2 4\n");
+        Bounds3f b = meshBounds(m);
+        checkVec(b.min, Vec3(0, 0, -4), 0.0);
+        checkVec(b.max, Vec3(1, 1, 5), 0.0);
     }
 }
 
@@ -204,6 +231,11 @@ TEST_SUITE("exercise 3.5") {
             CHECK_FALSE(overlaps(Bounds3d(lo, hi), a));
         }
     }
+    TEST_CASE("overlap: boxes that only touch overlap (closed boxes)") {
+        Bounds3d a({0, 0, 0}, {1, 1, 1});
+        CHECK(overlaps(a, Bounds3d({1, 0, 0}, {2, 1, 1})));     // a shared face
+        CHECK(overlaps(Bounds3d({-1, -1, -1}, {0, 0, 0}), a));  // a shared corner
+    }
     TEST_CASE("hard case: the slide's half test reports a false overlap") {
         // The slide: (A.bmin.x < B.bmax.x) && (A.bmin.y < B.bmax.y) && (A.bmin.z < B.bmax.z).
         // B lies entirely beyond A's max side on x: A.bmin < B.bmax holds on every axis, so
@@ -250,6 +282,13 @@ TEST_SUITE("exercise 3.6") {
         CHECK(f->tnear == 0.5f);
         CHECK(f->tfar == 0.75f);
         CHECK_FALSE(slabs(Rayd({-1, 0.75, 0.5}, {2, 1, 0}), kUnitBox));  // y leaves before x enters
+    }
+    TEST_CASE("slab test: a negative direction enters through the max plane") {
+        // From x = 5 along -x: the plane x = 1 at t = 4 first, x = 0 at t = 5.
+        auto h = slabs(Rayd({5, 0.5, 0.5}, {-1, 0, 0}), kUnitBox);
+        REQUIRE(h.has_value());
+        CHECK(h->tnear == 4.0);
+        CHECK(h->tfar == 5.0);
     }
     TEST_CASE("hard case: direction component +0.0") {
         checkSlabHardCase("+0", [](const auto& r, const auto& b) { return slabs(r, b); });
@@ -384,6 +423,18 @@ TEST_SUITE("exercise 3.7") {
         REQUIRE(f.has_value());
         CHECK(f->tfar > 0.75f);
         CHECK(f->tfar < 0.75f * 1.000001f);
+    }
+    TEST_CASE("conservative slab test: the far end grows and the near end stays") {
+        // Against the robust test on the same rays: tnear equal, tfar larger.
+        for (const Rayd& ray : {Rayd({-1, 0.25, 0.5}, {2, 1, 0}), Rayd({5, 0.5, 0.5}, {-1, 0, 0}),
+                                Rayd({-3, -2, -1}, {1, 0.75, 0.5})}) {
+            auto robust = slabs(ray, kUnitBox), wide = conservative(ray, kUnitBox);
+            INFO("origin " << ray.origin << " direction " << ray.direction);
+            REQUIRE(robust.has_value());
+            REQUIRE(wide.has_value());
+            CHECK(wide->tnear == robust->tnear);
+            CHECK(wide->tfar > robust->tfar);
+        }
     }
     TEST_CASE("conservative slab test: the same named hard cases") {
         auto test = [](const auto& r, const auto& b) { return conservative(r, b); };

@@ -311,7 +311,7 @@ TEST_SUITE("spatial splits 04") {
         Bvh bvh = buildEngineBvh(sh1, sbvhOptions());
         checkEveryPointCovered(sh1, bvh);
         for (RayKind kind : {RayKind::Primary, RayKind::Diffuse, RayKind::Random}) {
-            INFO(rayKindName(kind));
+            INFO(std::string(rayKindName(kind)));
             checkAgainstBruteForce(sh1, bvh, makeRays(sh1, kind, 400, 47), 40);
         }
         size_t rays = 0;

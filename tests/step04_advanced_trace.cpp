@@ -66,7 +66,7 @@ TEST_SUITE("trace 04") {
         for (BvhBuilder b : kExerciseBuilders) {
             Bvh bvh = buildBvh(sh1, optionsFor(b));
             for (RayKind kind : {RayKind::Primary, RayKind::Diffuse, RayKind::Random}) {
-                INFO(bvhBuilderName(b) << " " << rayKindName(kind));
+                INFO(std::string(bvhBuilderName(b)) << " " << std::string(rayKindName(kind)));
                 std::vector<Ray> rays = makeRays(sh1, kind, 400, 19);
                 size_t differ = 0, hits = 0;
                 for (const Ray& r : rays) {
@@ -195,7 +195,7 @@ TEST_SUITE("program 04") {
         std::vector<Ray> rays = makeRays(sh1, RayKind::Primary, 900, 3);
         writeRays(dir.file("rays.bin"), rays);
         for (const char* builder : {"midpoint", "median", "sah"}) {
-            INFO(builder);
+            INFO(std::string(builder));
             auto run =
                 test::runProgram(program,
                                  "trace --mesh " + test::dataDir() +

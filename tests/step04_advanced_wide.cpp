@@ -86,7 +86,7 @@ size_t checkAgainstBruteForce(const Mesh& m, const BvhWide<W>& wide, size_t rays
                               uint64_t seed) {
     size_t hits = 0;
     for (RayKind kind : {RayKind::Primary, RayKind::Diffuse, RayKind::Random}) {
-        INFO(rayKindName(kind));
+        INFO(std::string(rayKindName(kind)));
         std::vector<Ray> rays = makeRays(m, kind, raysPerKind, seed);
         std::vector<TraceHit> brute, tree;
         traceBatchBruteForce(m, rays, brute, 1);
@@ -540,7 +540,7 @@ TEST_SUITE("bvh 4-wide") {
     template <int W>
     void cracksCase() {
         for (const char* name : {"sh1", "bunny"}) {
-            INFO(name);
+            INFO(std::string(name));
             Mesh m = loadObj(test::dataDir() + "/meshes/" + name + ".obj");
             BvhWide<W> wide = wideTree<W>(m);
             size_t rays = 0;
@@ -685,7 +685,8 @@ TEST_SUITE("bvh 4-wide") {
             Bvh4 wide = collapseToBvh4(binary);
             Bvh8 wide8 = collapseToBvh8(binary);
             for (RayKind kind : {RayKind::Primary, RayKind::Diffuse, RayKind::Random}) {
-                INFO(rayKindName(kind) << (m == &far ? " rays, far mesh" : " rays, bunny"));
+                INFO(std::string(rayKindName(kind))
+                     << std::string(m == &far ? " rays, far mesh" : " rays, bunny"));
                 std::vector<Ray> rays = m == &far ? raysAtTriangles(far, 3000, 5e20f, int(kind))
                                                   : makeRays(*m, kind, 3000, 43);
                 std::vector<TraceHit> fast2, fast4, fast8, base2, base4, base8;

@@ -18,6 +18,12 @@ TEST_SUITE("exercise 4.1") {
         CHECK(left == 3);
         for (size_t i = 0; i < prims.size(); ++i) CHECK((prims[i].centroid.x < 5.5f) == (i < 3));
     }
+    TEST_CASE("midpoint: the middle of centroid bounds away from the origin") {
+        // Centroids at x = 100.5, 101.5, 102.5, 110.5: the middle is 105.5.
+        auto prims = primitivesOf({unitBoxAt({110, 0, 0}), unitBoxAt({100, 0, 0}),
+                                   unitBoxAt({102, 0, 0}), unitBoxAt({101, 0, 0})});
+        CHECK(partitionMidpoint(prims, centroidBounds(prims)) == 3);
+    }
     TEST_CASE("midpoint: the longest axis of the centroid bounds is split") {
         auto prims = primitivesOf({unitBoxAt({0, 0, 0}), unitBoxAt({0, 8, 0}), unitBoxAt({1, 1, 0}),
                                    unitBoxAt({0, 5, 1})});
@@ -45,6 +51,18 @@ TEST_SUITE("exercise 4.2") {
         float maxLeft = std::max(prims[0].centroid.x, prims[1].centroid.x);
         for (size_t i = 2; i < prims.size(); ++i) CHECK(prims[i].centroid.x >= maxLeft);
         CHECK(maxLeft == 1.5f);
+    }
+    TEST_CASE("median: the split runs along the longest axis of the centroid bounds") {
+        // Centroids spread 0..30 along y, 0..3 along x in the other order: the two lowest
+        // in y go left (the two lowest in x are the highest in y).
+        auto prims = primitivesOf({unitBoxAt({3, 0, 0}), unitBoxAt({0, 30, 0}),
+                                   unitBoxAt({2, 10, 0}), unitBoxAt({1, 20, 0})});
+        size_t left = partitionMedian(prims, centroidBounds(prims));
+        REQUIRE(left == 2);
+        for (size_t i = 0; i < prims.size(); ++i) {
+            INFO("primitive " << i << " centroid " << prims[i].centroid);
+            CHECK((prims[i].centroid.y < 15.0f) == (i < 2));
+        }
     }
     TEST_CASE("median: a balanced tree") {
         Mesh m = triangleSoup(4096, 8);
@@ -85,6 +103,53 @@ TEST_SUITE("exercise 4.3") {
         CHECK(left == 3);
         CHECK(cost == doctest::Approx(1.0 + 84.0 / 46.0).epsilon(1e-6));
     }
+    TEST_CASE("binned SAH: the cost of a split includes the traversal cost") {
+        // The two clusters again with a traversal cost of 3: 3 + 12 / 42 (intersection 1).
+        auto prims =
+            primitivesOf({unitBoxAt({9, 0, 0}), unitBoxAt({0, 0, 0}), unitBoxAt({0, 0, 0})});
+        BvhBuildOptions o = optionsFor(BvhBuilder::BinnedSah);
+        o.traversalCost = 3.0f;
+        o.intersectionCost = 1.0f;
+        float cost = 0.0f;
+        size_t left = partitionBinnedSah(prims, boundsOf(prims), centroidBounds(prims), o, cost);
+        CHECK(left == 2);
+        CHECK(cost == doctest::Approx(3.0 + (6.0 * 2 + 6.0) / 42.0).epsilon(1e-6));
+    }
+    TEST_CASE("binned SAH: the primitives are partitioned at the plane that was priced") {
+        // Centroids 0.5, 1.5 and 9.5: the cheapest plane leaves the box at 9 alone on the right.
+        auto prims =
+            primitivesOf({unitBoxAt({9, 0, 0}), unitBoxAt({1, 0, 0}), unitBoxAt({0, 0, 0})});
+        float cost = 0.0f;
+        size_t left = partitionBinnedSah(prims, boundsOf(prims), centroidBounds(prims),
+                                         optionsFor(BvhBuilder::BinnedSah), cost);
+        REQUIRE(left == 2);
+        CHECK(prims[2].centroid.x == 9.5f);
+    }
+    TEST_CASE("binned SAH: a split along z is found") {
+        // Three boxes: two at z = 0, one at z = 20; x and y are all the same.
+        auto prims =
+            primitivesOf({unitBoxAt({0, 0, 20}), unitBoxAt({0, 0, 0}), unitBoxAt({0, 0, 0.5f})});
+        float cost = 0.0f;
+        size_t left = partitionBinnedSah(prims, boundsOf(prims), centroidBounds(prims),
+                                         optionsFor(BvhBuilder::BinnedSah), cost);
+        REQUIRE(left == 2);
+        CHECK(prims[2].centroid.z == 20.5f);
+    }
+    TEST_CASE("binned SAH: costs are relative to the node's surface area") {
+        // Three unit boxes in a node given as [0, 10] x [0, 2] x [0, 1], area 2 (20 + 2 + 10)
+        // = 64: the best split {0, 1} | {9} costs 1 + (A([0,2]x[0,1]^2) 2 + 6) / 64, with
+        // intersection cost 1.
+        auto prims =
+            primitivesOf({unitBoxAt({9, 0, 0}), unitBoxAt({0, 0, 0}), unitBoxAt({1, 0, 0})});
+        BvhBuildOptions o = optionsFor(BvhBuilder::BinnedSah);
+        o.traversalCost = 1.0f;
+        o.intersectionCost = 1.0f;
+        float cost = 0.0f;
+        Bounds3f node(Vec3(0, 0, 0), Vec3(10, 2, 1));
+        size_t left = partitionBinnedSah(prims, node, centroidBounds(prims), o, cost);
+        CHECK(left == 2);
+        CHECK(cost == doctest::Approx(1.0 + (10.0 * 2 + 6.0) / 64.0).epsilon(1e-6));
+    }
     TEST_CASE("binned SAH: identical centroids give no split and no division by zero") {
         auto prims =
             primitivesOf({unitBoxAt({1, 2, 3}), unitBoxAt({1, 2, 3}), unitBoxAt({1, 2, 3})});
@@ -114,7 +179,7 @@ TEST_SUITE("hard cases 04") {
     TEST_CASE("hard case: identical centroids build a finite tree for every builder") {
         std::vector<Bounds3f> boxes(1000, Bounds3f(Vec3(-1.0f), Vec3(1.0f)));
         for (BvhBuilder b : kExerciseBuilders) {
-            INFO(bvhBuilderName(b));
+            INFO(std::string(bvhBuilderName(b)));
             BvhBuildStats s;
             Bvh bvh = buildBvh(boxes, optionsFor(b), &s);
             checkStructure(bvh, boxes);
@@ -130,7 +195,7 @@ TEST_SUITE("hard cases 04") {
             line.push_back({Vec3(float(i), 0.0f, 0.0f), Vec3(float(i), 0.0f, 0.0f)});
         }
         for (BvhBuilder b : kExerciseBuilders) {
-            INFO(bvhBuilderName(b));
+            INFO(std::string(bvhBuilderName(b)));
             checkStructure(buildBvh(flat, optionsFor(b)), flat);
             checkStructure(buildBvh(line, optionsFor(b)), line);
             BvhBuildOptions capped = optionsFor(b);
@@ -156,7 +221,7 @@ TEST_SUITE("hard cases 04") {
         Mesh m = triangleSoup(50000, 10, 0.01f);
         for (Vec3& p : m.positions) p = p * 1e20f + Vec3(3e20f, -1e20f, 0.0f);
         for (BvhBuilder b : kExerciseBuilders) {
-            INFO(bvhBuilderName(b));
+            INFO(std::string(bvhBuilderName(b)));
             Bvh bvh = buildBvh(m, optionsFor(b));
             checkStructure(bvh, triangleBounds(m));
             // A ray at the centroid of triangle 123 finds a triangle at least that near.
@@ -176,7 +241,7 @@ TEST_SUITE("hard cases 04") {
         m.positions = {{-1e21f, -1e21f, -5e20f}, {1e21f, -1e21f, -5e20f}, {0.0f, 1e21f, -5e20f}};
         m.triangles = {{0, 1, 2}};
         for (BvhBuilder b : kExerciseBuilders) {
-            INFO(bvhBuilderName(b));
+            INFO(std::string(bvhBuilderName(b)));
             Bvh bvh = buildBvh(m, optionsFor(b));
             TraceHit h = traceNearest(bvh, Ray(Vec3(0.0f), Vec3(0.0f, 0.0f, -1.0f)));
             CHECK(h.triangle == 0u);
@@ -209,7 +274,7 @@ TEST_SUITE("hard cases 04") {
         CHECK(ahead.triangle == 0u);
         CHECK(ahead.t == doctest::Approx(8e-28).epsilon(1e-5));
         for (BvhBuilder b : kExerciseBuilders) {
-            INFO(bvhBuilderName(b));
+            INFO(std::string(bvhBuilderName(b)));
             CHECK(traceNearest(buildBvh(m, optionsFor(b)), away).triangle == kNoPrimitive);
             CHECK(traceNearest(buildBvh(flat, optionsFor(b)), awayFuzz).triangle == kNoPrimitive);
         }

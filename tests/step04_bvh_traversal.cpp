@@ -48,6 +48,75 @@ TEST_SUITE("exercise 4.4") {
         CHECK(tClosest == 1.0f);
         CHECK(calls == std::vector<uint32_t>{1});
     }
+    TEST_CASE("nearest hit: after a hit the children beyond it are not opened") {
+        // The ray along -z from z = 10 (t = 10 - z). Root: leaf A (z in [8, 9.5], entered
+        // at t = 0.5, its primitive hit at t = 1) and inner node B (entered at t = 0.8,
+        // before that hit, so it is opened). B's children: B1 beside the ray, B2 in z [0, 4]
+        // (entered at t = 6): tested against the hit at t = 1, B2 is never opened. Tested
+        // against the ray's tmax it is, and its primitive is tested for nothing.
+        Bvh bvh;
+        bvh.nodes.resize(5);
+        bvh.nodes[0] = {Vec3(-1, -1, 0), 1, Vec3(3, 1, 9.5f), 0};
+        bvh.nodes[1] = {Vec3(-1, -1, 8), 0, Vec3(1, 1, 9.5f), 1};  // A, slot 0
+        bvh.nodes[2] = {Vec3(-1, -1, 0), 3, Vec3(3, 1, 9.2f), 0};  // B
+        bvh.nodes[3] = {Vec3(2, -1, 8), 1, Vec3(3, 1, 9.2f), 1};   // B1, slot 1
+        bvh.nodes[4] = {Vec3(-1, -1, 0), 2, Vec3(1, 1, 4), 1};     // B2, slot 2
+        bvh.primitiveIndices = {0, 1, 2};
+        std::vector<uint32_t> calls;
+        Ray ray(Vec3(0.2f, 0.1f, 10.0f), Vec3(0, 0, -1));
+        float tClosest = ray.tmax;
+        uint32_t slot =
+            traverseNearest(bvh, TraversalRay(ray), tClosest, [&](uint32_t s, float& tmax) {
+                calls.push_back(s);
+                float t = s == 0 ? 1.0f : 7.0f;
+                if (t > tmax) return false;
+                tmax = t;
+                return true;
+            });
+        CHECK(slot == 0);
+        CHECK(tClosest == 1.0f);
+        CHECK(calls == std::vector<uint32_t>{0});
+    }
+    TEST_CASE("nearest hit: a postponed node entered beyond the nearest hit is not opened") {
+        // The near leaf stored first this time: its hit at t = 1 ends the search before the
+        // far leaf, which the ray enters at t = 5.
+        Bvh bvh;
+        bvh.nodes.resize(3);
+        bvh.nodes[0] = {Vec3(-1, -1, 0), 1, Vec3(1, 1, 9), 0};
+        bvh.nodes[1] = {Vec3(-1, -1, 9), 0, Vec3(1, 1, 9), 1};  // near leaf, slot 0
+        bvh.nodes[2] = {Vec3(-1, -1, 0), 1, Vec3(1, 1, 5), 1};  // far leaf, slot 1
+        bvh.primitiveIndices = {0, 1};
+        std::vector<uint32_t> calls;
+        Ray ray(Vec3(0.2f, 0.1f, 10.0f), Vec3(0, 0, -1));
+        float tClosest = ray.tmax;
+        uint32_t slot =
+            traverseNearest(bvh, TraversalRay(ray), tClosest, [&](uint32_t s, float& tmax) {
+                calls.push_back(s);
+                float t = s == 0 ? 1.0f : 7.0f;
+                if (t > tmax) return false;
+                tmax = t;
+                return true;
+            });
+        CHECK(slot == 0);
+        CHECK(calls == std::vector<uint32_t>{0});
+    }
+    TEST_CASE("nearest hit: the nearest of two overlapping hits and not the first found") {
+        // One leaf with two primitives: slot 0 hit at t = 5, slot 1 at t = 2.
+        Bvh bvh;
+        bvh.nodes = {{Vec3(-1, -1, 0), 0, Vec3(1, 1, 9), 2}};
+        bvh.primitiveIndices = {0, 1};
+        Ray ray(Vec3(0.2f, 0.1f, 10.0f), Vec3(0, 0, -1));
+        float tClosest = ray.tmax;
+        uint32_t slot =
+            traverseNearest(bvh, TraversalRay(ray), tClosest, [&](uint32_t s, float& tmax) {
+                float t = s == 0 ? 5.0f : 2.0f;
+                if (t > tmax) return false;
+                tmax = t;
+                return true;
+            });
+        CHECK(slot == 1);
+        CHECK(tClosest == 2.0f);
+    }
     TEST_CASE("a miss of the root box tests nothing and an empty tree misses") {
         Mesh m = triangleSoup(100, 13);
         Bvh bvh = referenceTree(m);
@@ -117,5 +186,21 @@ TEST_SUITE("exercise 4.5") {
         });
         CHECK(any);
         CHECK(hitsSeen == 1);
+    }
+    TEST_CASE("any hit: boxes beyond the shadow ray's end are not opened") {
+        // The shadow ray from z = 10 along -z ends at t = 2. Leaf A (z in [0, 5]) starts at
+        // t = 5: never opened. Leaf B is beside the ray.
+        Bvh bvh;
+        bvh.nodes.resize(3);
+        bvh.nodes[0] = {Vec3(-1, -1, 0), 1, Vec3(3, 1, 9.5f), 0};
+        bvh.nodes[1] = {Vec3(-1, -1, 0), 0, Vec3(1, 1, 5), 1};    // A, slot 0
+        bvh.nodes[2] = {Vec3(2, -1, 8), 1, Vec3(3, 1, 9.5f), 1};  // B, slot 1
+        bvh.primitiveIndices = {0, 1};
+        Ray ray(Vec3(0.2f, 0.1f, 10.0f), Vec3(0, 0, -1), 0.0f, 2.0f);
+        int calls = 0;
+        bool any =
+            traverseAny(bvh, TraversalRay(ray), [&](uint32_t, float) { return ++calls < 0; });
+        CHECK_FALSE(any);
+        CHECK(calls == 0);
     }
 }

@@ -47,7 +47,46 @@ TEST_SUITE("exercise 4.6") {
     }
 }
 
+TEST_SUITE("exercise 4.6") {
+    TEST_CASE("frustum: the side planes follow the aspect ratio") {
+        // The 90 degree camera with aspect 2: the far corners at x = +-200, y = +-100.
+        Camera c = frustumCamera();
+        c.aspect = 2.0f;
+        Frustum f = makeFrustum(c, 1.0f, 100.0f);
+        test::checkVec(f.corners[5], Vec3(200, 100, -100), 1e-3);
+        // 15 to the right at distance 10 is inside (x / -z = 1.5 < 2).
+        for (const auto& plane : f.planes)
+            CHECK(glm::dot(plane.normal, Vec3(15, 0, -10)) + plane.d >= 0.0f);
+    }
+    TEST_CASE("frustum: near and far must satisfy 0 < near < far") {
+        Camera c;
+        CHECK_THROWS_AS(makeFrustum(c, 0.0f, 1.0f), std::invalid_argument);
+        CHECK_THROWS_AS(makeFrustum(c, -1.0f, 5.0f), std::invalid_argument);
+        CHECK_THROWS_AS(makeFrustum(c, 2.0f, 2.0f), std::invalid_argument);
+        CHECK_THROWS_AS(makeFrustum(c, 1.0f, kInfinity<float>), std::invalid_argument);
+    }
+}
+
 TEST_SUITE("exercise 4.7") {
+    TEST_CASE("p-vertex: a box touching a plane is kept") {
+        // Between the eye and the near plane z = -1, its face on that plane: touching counts.
+        CHECK_FALSE(cullByPlanes(handFrustum(), {Vec3(-0.5f, -0.5f, -1), Vec3(0.5f, 0.5f, -0.5f)}));
+    }
+    TEST_CASE("p-vertex: every plane can cull") {
+        // A small box outside each plane in turn (and inside the other five where it can be).
+        Frustum f = handFrustum();
+        const Bounds3f outside[] = {
+            {Vec3(-60, -1, -50), Vec3(-55, 1, -45)},               // left
+            {Vec3(55, -1, -50), Vec3(60, 1, -45)},                 // right
+            {Vec3(-1, -60, -50), Vec3(1, -55, -45)},               // bottom
+            {Vec3(-1, 55, -50), Vec3(1, 60, -45)},                 // top
+            {Vec3(-0.1f, -0.1f, -0.9f), Vec3(0.1f, 0.1f, -0.5f)},  // before near
+            {Vec3(-1, -1, -130), Vec3(1, 1, -110)}};               // beyond far
+        for (const Bounds3f& box : outside) {
+            INFO("box " << box.min << " to " << box.max);
+            CHECK(cullByPlanes(f, box));
+        }
+    }
     TEST_CASE("p-vertex: outside one plane culled while straddling and inside kept") {
         Frustum f = handFrustum();
         CHECK(cullByPlanes(f, {Vec3(-1, -1, 1), Vec3(1, 1, 3)}));        // behind the eye
@@ -73,6 +112,15 @@ TEST_SUITE("exercise 4.8") {
         Frustum f = handFrustum();
         // Every frustum corner has x <= 100 < 101 = the box's min x.
         CHECK(cullByBoxPlanes(f, {Vec3(101, -1, -110), Vec3(105, 1, -95)}));
+    }
+    TEST_CASE("corners against box planes: a frustum entirely above the box culls it") {
+        // Every corner has y >= -100 > -150, the box's max y.
+        CHECK(cullByBoxPlanes(handFrustum(), {Vec3(-5, -200, -50), Vec3(5, -150, -40)}));
+    }
+    TEST_CASE("corners against box planes: a frustum touching a face keeps the box") {
+        // The far corners have x = 100: the box from x = 100 touches the frustum.
+        CHECK_FALSE(cullByBoxPlanes(handFrustum(), {Vec3(100, -5, -100), Vec3(110, 5, -90)}));
+        CHECK_FALSE(cullByBoxPlanes(handFrustum(), {Vec3(-5, -5, -120), Vec3(5, 5, -100)}));
     }
     TEST_CASE("corners against box planes: boxes the frustum reaches are kept") {
         Frustum f = handFrustum();

@@ -78,6 +78,20 @@ TEST_SUITE("exercise 5.1") {
         for (int i = 0; i < 3600; i += 37)
             CHECK(t[size_t(i)] == float(std::sin(2.0 * M_PI * i / 3600.0)));
     }
+    TEST_CASE("sine table: n + 1 entries with the last repeating the first") {
+        std::vector<float> t = fillSinTable(8);
+        REQUIRE(t.size() == 9);
+        CHECK(t[8] == t[0]);
+    }
+    TEST_CASE("sine table: every entry is the float nearest the true sine") {
+        // Computed in double and rounded once; in float the angle itself is rounded first.
+        std::vector<float> t = fillSinTable(3600);
+        REQUIRE(t.size() == 3601);
+        int off = 0;
+        for (int i = 0; i < 3600; ++i)
+            off += t[size_t(i)] != float(std::sin(2.0 * M_PI * i / 3600.0));
+        CHECK(off == 0);
+    }
     TEST_CASE("hard case: a table of fewer than 2 entries is refused") {
         CHECK_THROWS_AS(fillSinTable(1), std::invalid_argument);
         CHECK_THROWS_AS(fillSinTable(0), std::invalid_argument);
@@ -95,6 +109,12 @@ TEST_SUITE("exercise 5.2") {
         CHECK(t.sinNearest(float(5 * M_PI / 2)) == doctest::Approx(1.0f));
         CHECK(t.sinNearest(float(-6 * M_PI + 1.0)) == doctest::Approx(std::sin(1.0)).epsilon(1e-3));
         CHECK(t.cosNearest(0.0f) == doctest::Approx(1.0f));
+    }
+    TEST_CASE("nearest entry: a negative angle wraps to the end of the table") {
+        // -30 degrees is entry 330 of 360: sin = -0.5, not the +0.5 of entry 30.
+        SinTable t(referenceTable(360));
+        CHECK(t.sinNearest(float(-M_PI / 6)) == doctest::Approx(-0.5f).epsilon(1e-3));
+        CHECK(t.sinNearest(float(-7 * M_PI / 6)) == doctest::Approx(0.5f).epsilon(1e-3));
     }
     TEST_CASE("nearest entry: within the stated bound (half a step) over the full circle") {
         for (int n : {360, 3600}) {
@@ -175,6 +195,10 @@ TEST_SUITE("exercise 5.5") {
               doctest::Approx(std::sqrt(20400.0)).epsilon(1e-6));
         CHECK(finiteLightRadius(Vec3(0.0f)) == 0.0f);
     }
+    TEST_CASE("finite light radius: the brightest component decides") {
+        // Green 9, red and blue 0: the radius where 9 / r^2 = 1 is 3 (the mean would give 1.7).
+        CHECK(finiteLightRadius(Vec3(0.0f, 9.0f, 0.0f), 1.0f) == doctest::Approx(3.0f));
+    }
     TEST_CASE("hard case: a zero or negative threshold is refused") {
         CHECK_THROWS_AS(finiteLightRadius(Vec3(1.0f), 0.0f), std::invalid_argument);
         CHECK_THROWS_AS(finiteLightRadius(Vec3(1.0f), -1.0f), std::invalid_argument);
@@ -197,6 +221,13 @@ TEST_SUITE("exercise 5.6") {
         // x = 1 and y = 1 with zero direction components there: 0 * inf = NaN by design.
         test::FpTrapsOff nanOnPurpose;
         CHECK(slabReciprocal(precomputeRay(Ray(Vec3(1, 1, 5), Vec3(0, 0, -1))), box).has_value());
+    }
+    TEST_CASE("reciprocal slab test: the entry distance is returned") {
+        // From z = 5 along -z into [-1, 1]^3: entry at t = 4, exit at t = 6.
+        auto t = slabReciprocal(precomputeRay(Ray(Vec3(0.5f, 0, 5), Vec3(0, 0, -1))),
+                                Bounds3f(Vec3(-1), Vec3(1)));
+        REQUIRE(t.has_value());
+        CHECK(*t == 4.0f);
     }
     TEST_CASE("reciprocal slab results equal the division form on random rays") {
         std::mt19937_64 rng(5);
@@ -289,6 +320,14 @@ TEST_SUITE("exercise 5.8") {
         CHECK(worst < 0.00176);  // Lomont 2003: 0.175% after one Newton step
         CHECK(worst > 0.0015);   // one step, not an exact answer
     }
+    TEST_CASE("approximate reciprocal square root: the initial guess halves the exponent") {
+        // x = 4^k: x^(-1/2) = 2^-k over 40 octaves, within a percent.
+        for (int k = -10; k <= 10; ++k) {
+            float x = std::ldexp(1.0f, 2 * k);
+            INFO("x = 2^" << 2 * k);
+            CHECK(approxInverseSqrt(x) == doctest::Approx(std::ldexp(1.0, -k)).epsilon(0.01));
+        }
+    }
 }
 
 TEST_SUITE("exercise 5.9") {
@@ -331,12 +370,22 @@ TEST_SUITE("exercise 5.9") {
                 REQUIRE(lines == expected);  // the first wrong frame says it, once
                 if (lines > 1) CHECK(f.now - start <= c.budget + 1e-12);
                 ++frames;
+                REQUIRE(frames <= 40);  // a frame without a line would loop here forever
             }
             CHECK(f.rendered == 40);  // every line once: each frame resumed where it stopped
             CHECK(frames == (40 + c.perFrame - 1) / c.perFrame);
             for (int y = 0; y < 40; ++y) CHECK(r.image().at(0, y).x == float(y));
             CHECK(r.advance(c.budget) == 0);  // complete: nothing more to do
         }
+    }
+    TEST_CASE("incremental renderer: a line more expensive than the budget still advances") {
+        // 20 ms a line, 15 ms a frame: one line per frame, or the image never progresses.
+        FakeLines f;
+        f.cost = 20 * kMs;
+        IncrementalRenderer r(
+            4, 3, [&](Image&, int) { f.now += f.cost; }, f.clock());
+        CHECK(r.advance(15 * kMs) == 1);
+        CHECK(r.linesDone() == 1);
     }
     TEST_CASE("incremental renderer: the completed image equals the direct render bit for bit") {
         Scene scene = makeScene("spheres", {});
@@ -362,6 +411,7 @@ TEST_SUITE("exercise 5.9") {
             int before = r.linesDone();
             REQUIRE(r.advance(15 * kMs) == std::min(3, s.height - before));  // floor(15 / 4) lines
             ++frames;
+            REQUIRE(frames <= s.height);
         }
         CHECK(frames == 12);
         CHECK(bitIdentical(r.image(), direct));
@@ -407,6 +457,17 @@ TEST_SUITE("exercise 5.10") {
         a.update(0.02);
         CHECK(a.scale() == doctest::Approx(0.5f));
     }
+    TEST_CASE("adaptive resolution: the scale changes by the square root of the time ratio") {
+        // Twice too slow: the pixels halve, so each side shrinks by 1/sqrt(2).
+        AdaptiveResolution a(0.02);
+        a.update(0.04);
+        CHECK(a.scale() == doctest::Approx(std::sqrt(0.5)));
+    }
+    TEST_CASE("adaptive resolution: one slow frame changes the scale by at most a factor 2") {
+        AdaptiveResolution a(0.02);
+        a.update(2.0);  // 100 times too slow, once
+        CHECK(a.scale() == doctest::Approx(0.5f));
+    }
     TEST_CASE("hard case: adaptive resolution stays within its limits") {
         AdaptiveResolution a(0.03, 0.25f, 1.0f);
         for (int i = 0; i < 10; ++i) a.update(10.0);  // hopelessly slow
@@ -438,7 +499,7 @@ TEST_SUITE("renderer 05") {
             Image a = renderImage(scene, scene.camera, s, &on);
             s.forceAllEffects = true;
             Image b = renderImage(scene, scene.camera, s, &forced);
-            INFO(name);
+            INFO(std::string(name));
             CHECK(bitIdentical(a, b));
             CHECK(on.primary == forced.primary);
             CHECK(on.total() < forced.total());
@@ -473,7 +534,7 @@ TEST_SUITE("renderer 05") {
             RayCounts cf, ci;
             Image a = renderImage(finite, finite.camera, s, &cf);
             Image b = renderImage(infinite, infinite.camera, s, &ci);
-            INFO(name);
+            INFO(std::string(name));
             CHECK(maxStep8(a, b) <= 1);
             CHECK(ci.lightsOutOfRange == 0);
             if (std::string(name) == "small-lights") {

@@ -158,6 +158,10 @@ TEST_SUITE("exercise 6.2") {
         checkVec(clipToScreen(Vec4d(3, -3, 3, 3), 8, 4), glm::dvec3(8, 4, 1),
                  1e-12);  // bottom-right
     }
+    TEST_CASE("clip to screen: a point with w other than 1 is divided by w") {
+        // (2, 0, 1, 4) is the normalized point (0.5, 0, 0.25): x = 1.5 * 0.5 * 8 = 6.
+        checkVec(clipToScreen(Vec4d(2, 0, 1, 4), 8, 4), glm::dvec3(6, 2, 0.25), 1e-12);
+    }
 }
 
 TEST_SUITE("exercise 6.3") {
@@ -180,6 +184,22 @@ TEST_SUITE("exercise 6.3") {
         checkVec(out.vertices[3].position, Vec4d(0.5, 0, -1, 1), 1e-15);
         checkVec(out.vertices[3].weights, glm::dvec3(0.5, 0, 0.5), 1e-15);
         CHECK(out.vertices[3].position.w == 1.0);
+    }
+    TEST_CASE("clipping: the new vertices carry interpolated weights") {
+        // a inside (z + w = 1), b outside (z + w = -3): the crossing a quarter of the way.
+        ClipPolygon out =
+            clipAgainstPlane(triangle({0, 0, 0, 1}, {0, 0, -4, 1}, {1, 0, 0, 1}), kClipNearPlane);
+        REQUIRE(out.count == 4);
+        checkVec(out.vertices[1].weights, glm::dvec3(0.75, 0.25, 0), 1e-15);
+        checkVec(out.vertices[2].weights, glm::dvec3(0, 0.25, 0.75), 1e-15);
+    }
+    TEST_CASE("clipping: the edge from the last vertex back to the first is clipped too") {
+        // a and b inside, c outside (z + w = -2): b -> c and the closing edge c -> a cross,
+        // each a third of the way from its inside end.
+        ClipPolygon out =
+            clipAgainstPlane(triangle({0, 0, 0, 1}, {1, 0, 0, 1}, {0, 1, -3, 1}), kClipNearPlane);
+        REQUIRE(out.count == 4);
+        checkVec(out.vertices[3].position, Vec4d(0, 1.0 / 3.0, -1, 1), 1e-15);
     }
     TEST_CASE(
         "one vertex inside gives a smaller triangle while all inside stays and all outside "
@@ -232,6 +252,10 @@ TEST_SUITE("exercise 6.4") {
         CHECK(edgeFunction(a, b, c) == 16);
         CHECK(edgeFunction(a, b, FixedPoint2{7, 0}) == 0);
         CHECK(edgeFunction(a, b, FixedPoint2{1, -2}) == -8);
+    }
+    TEST_CASE("edge function: an edge away from the origin") {
+        // (b - a) x (p - a) with a = (2, 1), b = (6, 1), p = (3, 4): 4 * 3 - 0 * 1 = 12.
+        CHECK(edgeFunction(FixedPoint2{2, 1}, FixedPoint2{6, 1}, FixedPoint2{3, 4}) == 12);
     }
     TEST_CASE("hard case: exactly opposite on a shared edge far from the origin") {
         FixedPoint2 a{123456789, -98765432}, b{-23456789, 87654321};
@@ -322,6 +346,17 @@ TEST_SUITE("exercise 6.6") {
         }
         CHECK(stored == 1.0f);
     }
+    TEST_CASE("z-buffer: the nearer depth is stored for the next triangle") {
+        float stored = kInfinity<float>;
+        REQUIRE(depthTest(stored, 4.0f));
+        CHECK(stored == 4.0f);
+        CHECK_FALSE(depthTest(stored, 5.0f));  // behind the first triangle
+    }
+    TEST_CASE("z-buffer: a farther fragment is rejected") {
+        float stored = 2.0f;
+        CHECK_FALSE(depthTest(stored, 7.0f));
+        CHECK(stored == 2.0f);
+    }
 }
 
 TEST_SUITE("exercise 6.7") {
@@ -348,6 +383,10 @@ TEST_SUITE("exercise 6.7") {
         // The affine (screen) weights are not the 3D ones: that is the warp.
         CHECK(std::abs(screen.x - 0.2) > 0.05);
     }
+    TEST_CASE("perspective-correct weights: they sum to 1") {
+        glm::dvec3 l = perspectiveCorrectWeights(glm::dvec3(0.5, 0.25, 0.25), glm::dvec3(2, 3, 5));
+        CHECK(l.x + l.y + l.z == doctest::Approx(1.0).epsilon(1e-15));
+    }
 }
 
 TEST_SUITE("exercise 6.8") {
@@ -366,9 +405,34 @@ TEST_SUITE("exercise 6.8") {
         CHECK(litByShadowMap(map, Vec3(0.5f, 0.5f, 4.0f), 0.0));     // behind the light
         CHECK(litByShadowMap(map, Vec3(50.0f, 0.5f, -4.0f), 0.0));   // outside the map
     }
+    // A 2 x 2 map from the light at the origin looking down -z; only texel (1, 0), the
+    // top right, holds an occluder, at depth 5.
+    ShadowMap topRightMap() {
+        ShadowMap map;
+        map.size = 2;
+        map.viewProjection = glm::perspective(glm::radians(90.0), 1.0, 1.0, 100.0);
+        map.depth = {kInfinity<float>, 5.0f, kInfinity<float>, kInfinity<float>};
+        return map;
+    }
+    TEST_CASE("shadow map lookup: the bias lets a point just behind the stored depth be lit") {
+        // w = 5.5, 0.5 behind the stored 5: a bias of 1 accepts it as the same surface.
+        CHECK(litByShadowMap(topRightMap(), Vec3(0.5f, 0.5f, -5.5f), 1.0));
+    }
+    TEST_CASE("shadow map lookup: the texel row counts from the top") {
+        // Up and right (y > 0) is row 0: the occluder's texel; down and right is row 1, empty.
+        CHECK_FALSE(litByShadowMap(topRightMap(), Vec3(2.0f, 2.0f, -10.0f), 0.0));
+        CHECK(litByShadowMap(topRightMap(), Vec3(2.0f, -2.0f, -10.0f), 0.0));
+    }
 }
 
 TEST_SUITE("exercise 6.9") {
+    TEST_CASE("hybrid shadow ray: the point's own surface does not shadow it") {
+        // A point on a floor plane lit from above: the ray starts on the plane (t = 0).
+        Scene s;
+        s.lights.push_back({Vec3(0, 10, 0), Vec3(100.0f), kInfinity<float>});
+        s.planes.push_back({{Vec3(0, 1, 0), 0.0f}, 0});
+        CHECK(litByShadowRay(s, Vec3(3, 0, 0), Vec3(0, 1, 0), s.lights[0]));
+    }
     TEST_CASE("hybrid shadow ray: an occluder between the point and the light") {
         Scene s;
         s.lights.push_back({Vec3(0, 10, 0), Vec3(100.0f), kInfinity<float>});

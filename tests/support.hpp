@@ -7,12 +7,29 @@
 #include <cstdlib>
 #include <filesystem>
 #include <fstream>
+#include <limits>
 #include <sstream>
 #include <string>
 #include <vector>
 
 #include "core/math.hpp"
 #include "core/render.hpp"
+
+// A failing CHECK on GLM vectors prints them as (x, y, z), every digit that tells two
+// values apart, instead of doctest's {?}.
+namespace doctest {
+template <glm::length_t L, typename T, glm::qualifier Q>
+struct StringMaker<glm::vec<L, T, Q>> {
+    static String convert(const glm::vec<L, T, Q>& v) {
+        std::ostringstream s;
+        s.precision(std::numeric_limits<T>::max_digits10);
+        s << "(";
+        for (glm::length_t i = 0; i < L; ++i) s << (i ? ", " : "") << +v[i];
+        s << ")";
+        return String(s.str().c_str());
+    }
+};
+}  // namespace doctest
 
 namespace boxes::test {
 
@@ -103,7 +120,7 @@ inline ProgramRun runHeadless(const std::string& program, const TempDir& dir, in
 inline void checkReportTables(const std::string& path, std::initializer_list<const char*> ids) {
     std::string json = readText(path);
     for (const char* id : ids) {
-        INFO(id);
+        INFO(std::string(id));
         CHECK(json.find(std::string("\"") + id + "\"") != std::string::npos);
     }
 }
@@ -146,8 +163,8 @@ inline void checkBadInput(const std::string& program, const TempDir& dir,
 template <typename A, typename B>
 void checkVec(const A& actual, const B& expected, double tolerance) {
     for (int i = 0; i < 3; ++i) {
-        INFO("component " << i << ": got " << double(actual[i]) << ", expected "
-                          << double(expected[i]));
+        INFO("component " << i << " of " << actual << ": got " << double(actual[i]) << ", expected "
+                          << double(expected[i]) << " (of " << expected << ")");
         CHECK(std::abs(double(actual[i]) - double(expected[i])) <= tolerance);
     }
 }

@@ -113,6 +113,31 @@ class KitContents(unittest.TestCase):
                      "tests/hints/exercises.json", "tests/hints/mistakes.json"):
             self.assertNotIn(path, kit.NOT_IN_KIT)
         self.assertIn("tests/check_test.py", kit.NOT_IN_KIT)
+        # The mistakes' catalogue patches the solutions: it stays out with its runner.
+        self.assertIn("tools/grading/mutants.py", kit.NOT_IN_KIT)
+        self.assertFalse(kit.in_kit("tests/mutants/1.4-no-v-rejection.patch"))
+        self.assertTrue(kit.in_kit("tests/hints/mistakes.json"))
+
+    def test_a_written_kit_has_no_mutant_patches(self):
+        # A tree outside git (tracked_files walks it) with one exercise and one mutant.
+        root = tempfile.mkdtemp()
+        files = {"steps/01_x/x.cpp": SOURCE, "tests/mutants/1.1-wrong-sum.patch":
+                 "Mistake: a - b\nCaught by: sum\n\n-    float secret = a + b;\n+    float secret = a - b;\n",
+                 "tests/hints/mistakes.json": "{}", "tools/grading/mutants.py": "# runner\n"}
+        for rel, text in files.items():
+            os.makedirs(os.path.dirname(os.path.join(root, rel)), exist_ok=True)
+            with open(os.path.join(root, rel), "w") as f:
+                f.write(text)
+        dest = os.path.join(tempfile.mkdtemp(), "kit")
+        kit.write_kit(dest, root)
+        written = kit.tracked_files(dest)
+        self.assertIn("tests/hints/mistakes.json", written)
+        self.assertIn("steps/01_x/x.cpp", written)
+        self.assertFalse(any(rel.startswith("tests/mutants") for rel in written), written)
+        self.assertNotIn("tools/grading/mutants.py", written)
+        for rel in written:
+            with open(os.path.join(dest, rel)) as f:
+                self.assertNotIn("secret", f.read(), rel)
 
     def test_tracked_files_outside_git_skip_build_output(self):
         root = tempfile.mkdtemp()

@@ -24,9 +24,16 @@ from .exercises import BEGIN, END, SOURCE_SUFFIXES, exercises, parse_file
 SKIP_DIRS = {".git", "build", "out", "kit", "node_modules", "__pycache__"}
 # The grader's modules: they belong to the instructor's reference tree (they need the
 # solutions). Their end-to-end tests and unit tests stay out with them.
-GRADER = ("grade", "grade_class", "gradescope", "class_bench")
+GRADER = ("grade", "grade_class", "gradescope", "class_bench", "mutants")
 NOT_IN_KIT = ({f"tools/grading/{m}.py" for m in GRADER} | {f"tests/tools/test_{m}.py" for m in GRADER}
               | {"tests/grading_test.py", "tests/class_grading_test.py", "tests/check_test.py"})
+# The catalogue of students' mistakes (tools/grading/mutants.py): patches of the solutions.
+NOT_IN_KIT_DIRS = ("tests/mutants/",)
+
+
+def in_kit(rel):
+    """Whether the tree's file `rel` (relative, with /) goes into the kit as it is or stubbed."""
+    return rel not in NOT_IN_KIT and not rel.startswith(NOT_IN_KIT_DIRS)
 CLASSROOM_WORKFLOW = ".github/workflows/classroom.yml"  # GitHub Classroom (classroom.py)
 
 
@@ -107,7 +114,7 @@ def write_kit(dest, root=ROOT):
         raise SystemExit(f"kit: {dest} exists and is not empty; choose a new folder")
     stubbed = []
     for rel in tracked_files(root):
-        if rel in NOT_IN_KIT:
+        if not in_kit(rel):
             continue
         src, dst = os.path.join(root, rel), os.path.join(dest, rel)
         os.makedirs(os.path.dirname(dst), exist_ok=True)

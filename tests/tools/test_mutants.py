@@ -1,0 +1,119 @@
+"""Tests of tools/grading/mutants.py: the catalogue of students' mistakes (tests/mutants) is
+sound (every patch applies to the reference, names its test case, and has that case's hint),
+and the runner's pieces work on a small tree. The slow run itself is the ctest label mutants."""
+import json
+import os
+import subprocess
+import sys
+import tempfile
+import unittest
+
+ROOT = os.path.dirname(os.path.dirname(os.path.dirname(os.path.abspath(__file__))))
+sys.path.insert(0, ROOT)
+from tools.grading import mutants  # noqa: E402
+
+PATCH = """Mistake: a + b written a - b
+Caught by: sum: worked values
+
+diff --git a/steps/01_x/x.cpp b/steps/01_x/x.cpp
+--- a/steps/01_x/x.cpp
++++ b/steps/01_x/x.cpp
+@@ -1,3 +1,3 @@
+ float sum(float a, float b) {
+-    return a + b;
++    return a - b;
+ }
+"""
+SOURCE = "float sum(float a, float b) {\n    return a + b;\n}\n"
+TESTS = 'TEST_SUITE("exercise 1.1") {\n    TEST_CASE("sum: worked values") {}\n}\n'
+
+
+def small_tree(patch=PATCH, hints=None):
+    root = tempfile.mkdtemp()
+    files = {"steps/01_x/x.cpp": SOURCE, "tests/step01_x.cpp": TESTS,
+             "tests/mutants/1.1-minus.patch": patch,
+             "tests/hints/mistakes.json": json.dumps(
+                 hints if hints is not None else
+                 {"sum: worked values": {"exercise": "1.1", "hint": "a sum adds"}})}
+    for rel, text in files.items():
+        os.makedirs(os.path.dirname(os.path.join(root, rel)), exist_ok=True)
+        with open(os.path.join(root, rel), "w") as f:
+            f.write(text)
+    return root
+
+
+class TheCatalogue(unittest.TestCase):
+    def test_every_patch_applies_names_its_case_and_has_its_hint(self):
+        problems = mutants.check_catalogue(ROOT)
+        self.assertEqual(problems, [], "\n".join(problems))
+
+    def test_every_exercise_has_at_least_two_mistakes(self):
+        from tools.grading.exercises import exercises
+        counts = {}
+        for m in mutants.catalogue(ROOT):
+            counts[m.exercise] = counts.get(m.exercise, 0) + 1
+        few = [e.id for e in exercises(ROOT) if counts.get(e.id, 0) < 2]
+        self.assertEqual(few, [], "exercises with fewer than two catalogued mistakes")
+
+    def test_the_three_the_audit_missed_are_catalogued(self):
+        ids = {m.id for m in mutants.catalogue(ROOT)}
+        for wanted in ("1.4-no-v-rejection", "1.5-no-double-fallback", "4.4-children-against-tmax"):
+            self.assertIn(wanted, ids)
+
+
+class Pieces(unittest.TestCase):
+    def test_the_header_is_read(self):
+        root = small_tree()
+        [m] = mutants.catalogue(root)
+        self.assertEqual((m.id, m.exercise, m.step), ("1.1-minus", "1.1", 1))
+        self.assertEqual(m.mistake, "a + b written a - b")
+        self.assertEqual(m.caught_by, "sum: worked values")
+        self.assertEqual(mutants.check_catalogue(root), [])
+
+    def test_a_stale_patch_a_missing_hint_and_an_unknown_case_are_problems(self):
+        root = small_tree(PATCH.replace("return a + b", "return a * b"), hints={})
+        problems = mutants.check_catalogue(root)
+        self.assertTrue(any("does not apply" in p for p in problems), problems)
+        self.assertTrue(any("no hint" in p for p in problems), problems)
+        root = small_tree(PATCH.replace("Caught by: sum: worked values", "Caught by: no such case"))
+        problems = mutants.check_catalogue(root)
+        self.assertTrue(any("no test case named 'no such case'" in p for p in problems), problems)
+
+    def test_apply_and_revert_in_a_copy_leave_the_reference(self):
+        root = small_tree()
+        tree = os.path.join(tempfile.mkdtemp(), "tree")
+        mutants.sync_tree(root, tree)
+        path = os.path.join(tree, "steps/01_x/x.cpp")
+        m = mutants.catalogue(root)[0]
+        self.assertEqual(mutants.git_apply(tree, m.path).returncode, 0)
+        with open(path) as f:
+            self.assertIn("a - b", f.read())
+        self.assertEqual(mutants.git_apply(tree, m.path, "-R").returncode, 0)
+        with open(path) as f:
+            self.assertEqual(f.read(), SOURCE)
+        # A second sync keeps unchanged files' times (the build stays incremental).
+        before = os.stat(os.path.join(tree, "tests/step01_x.cpp")).st_mtime_ns
+        mutants.sync_tree(root, tree)
+        self.assertEqual(os.stat(os.path.join(tree, "tests/step01_x.cpp")).st_mtime_ns, before)
+
+    def test_select_by_exercise_step_or_name(self):
+        root = small_tree()
+        all_ = mutants.catalogue(root)
+        self.assertEqual(mutants.select(all_, ["1.1"]), all_)
+        self.assertEqual(mutants.select(all_, ["01"]), all_)
+        self.assertEqual(mutants.select(all_, ["1.1-minus"]), all_)
+        with self.assertRaises(SystemExit):
+            mutants.select(all_, ["9.9"])
+
+    def test_the_table(self):
+        text = mutants.table([("1.4-no-v-rejection", "1.4", "caught", ["a case"]),
+                              ("4.4-x", "4.4", "MISSED", [])])
+        lines = text.split("\n")
+        self.assertTrue(lines[0].startswith("mutant"))
+        self.assertIn("caught", lines[1])
+        self.assertIn("a case", lines[1])
+        self.assertTrue(lines[2].rstrip().endswith("-"))
+
+
+if __name__ == "__main__":
+    unittest.main()

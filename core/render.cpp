@@ -33,43 +33,38 @@ bool boxTouchesBall(Vec3 lo, Vec3 hi, Vec3 centre, float radius) {
 
 }  // namespace
 
-SceneAnalysis analyzeScene(const Scene& scene) {
+SceneAnalysis analyzeScene(const Scene& scene, const AnalysisParts& parts) {
     SceneAnalysis a;
-    auto noteMaterial = [&](int m) {
-        const Material& mat = scene.materials[size_t(m)];
-        if (mat.kind == Material::Kind::Mirror && mat.reflectance > 0.0f) a.reflection = true;
-        if (mat.kind == Material::Kind::Glass) a.reflection = a.refraction = true;
-    };
-    for (const auto& s : scene.spheres) {
-        noteMaterial(s.material);
+    a.parts = parts;
+    for (size_t i = 0; i < scene.spheres.size(); ++i) {
         a.convex.push_back(true);
         a.isPlane.push_back(false);
     }
-    for (const auto& p : scene.planes) {
-        noteMaterial(p.material);
+    for (size_t i = 0; i < scene.planes.size(); ++i) {
         a.convex.push_back(true);
         a.isPlane.push_back(true);
     }
     for (const auto& g : scene.geometries) {
-        for (int m : g->materialsUsed()) noteMaterial(m);
         a.convex.push_back(g->convex());
         a.isPlane.push_back(false);
     }
     // An object outside a light's ball of influence cannot block that light for any lit
     // point: the segment from a lit point to the light lies inside the (convex) ball.
+    // Without light ranges a point beyond the radius is shaded too: no ball to rely on.
+    const bool perLight = parts.occludersPerLight && parts.lightRanges;
     for (const PointLight& light : scene.lights) {
+        const float radius = perLight ? light.radius : kInfinity<float>;
         std::vector<int> list;
         int object = 0;
         for (const auto& s : scene.spheres) {
             Vec3 r(s.shape.radius);
-            if (boxTouchesBall(s.shape.centre - r, s.shape.centre + r, light.position,
-                               light.radius))
+            if (boxTouchesBall(s.shape.centre - r, s.shape.centre + r, light.position, radius))
                 list.push_back(object);
             ++object;
         }
         for (size_t i = 0; i < scene.planes.size(); ++i) list.push_back(object++);
         for (const auto& g : scene.geometries) {
-            if (boxTouchesBall(g->boundsMin(), g->boundsMax(), light.position, light.radius))
+            if (boxTouchesBall(g->boundsMin(), g->boundsMax(), light.position, radius))
                 list.push_back(object);
             ++object;
         }
@@ -112,7 +107,7 @@ Renderer::Renderer(const Scene& scene, const Camera& camera, const RenderSetting
     if (settings.samplesPerPixel < 1) throw std::invalid_argument("samples per pixel must be >= 1");
     scene.checkRenderable();
     basis_ = camera_.basis();
-    analysis_ = analyzeScene(scene);
+    analysis_ = analyzeScene(scene, settings.analysis);
 }
 
 bool Renderer::needsShadowRay(int light, const SurfaceHit& hit) const {
@@ -123,10 +118,11 @@ bool Renderer::needsShadowRay(int light, const SurfaceHit& hit) const {
             // camera in a sphere) it blocks every light beyond it.
             bool inside = glm::dot(hit.geometricNormal, lightPos - hit.point) < 0.0f &&
                           !analysis_.isPlane[size_t(object)];
-            if (!analysis_.convex[size_t(object)] || inside) return true;
+            if (!analysis_.parts.convexSelf || !analysis_.convex[size_t(object)] || inside)
+                return true;
             continue;
         }
-        if (analysis_.isPlane[size_t(object)]) {
+        if (analysis_.parts.planeSides && analysis_.isPlane[size_t(object)]) {
             // A plane blocks only points on the other side from the light.
             const Plane& p = scene_.planes[size_t(object) - scene_.spheres.size()].shape;
             float sp = glm::dot(p.normal, hit.point) + p.d;
@@ -153,7 +149,10 @@ Vec3 Renderer::shade(const Ray& ray, const SurfaceHit& hit, int depth, RayCounts
             DirectLight light = directLight(m, scene_.lights[i], hit.point, normals);
             if (!light.inRange) ++counts.lightsOutOfRange;
             bool contributes = light.contributes();
-            if (!contributes && !force) continue;
+            // Behind the surface the light has zero weight; beyond its radius too, but
+            // only the analysis' light ranges may skip that shadow ray.
+            bool needed = analysis_.parts.lightRanges ? contributes : light.facing;
+            if (!needed && !force) continue;
             bool shadowNeeded = needsShadowRay(int(i), hit);
             bool visible = true;
             if (shadowNeeded || force) {

@@ -23,6 +23,17 @@ struct RayCounts {
     RayCounts& operator+=(const RayCounts& o);
 };
 
+// The parts of the scene analysis the renderer uses (all by default). With every part off
+// it still skips the rays of zero weight (lights behind the surface, zero reflectance, no
+// refraction): the fair baseline the analysis is measured against.
+struct AnalysisParts {
+    bool occludersPerLight = true;  // only objects whose bounds reach a light's ball block it
+    bool planeSides = true;         // a plane blocks only points on the far side from the light
+    bool convexSelf = true;         // a convex object cannot shadow its own outside
+    bool lightRanges = true;        // no shadow ray to a light beyond its radius
+    static AnalysisParts none() { return {false, false, false, false}; }
+};
+
 struct RenderSettings {
     int width = 640;
     int height = 480;
@@ -30,21 +41,22 @@ struct RenderSettings {
     int threads = 0;          // 0: every hardware thread
     int samplesPerPixel = 1;  // > 1: stratified jitter within the pixel
     uint64_t seed = 1;
-    bool forceAllEffects = false;  // trace every effect, as if the analysis were off
+    AnalysisParts analysis;        // which parts of the scene analysis skip shadow rays
+    bool forceAllEffects = false;  // trace every ray, zero weights too (naive renderer)
     std::string progressLabel;     // when set, long renders print progress to stderr
 };
 
-// What can contribute, derived once from the scene.
+// Which objects can block which light, derived once from the scene.
 struct SceneAnalysis {
-    bool reflection = false;  // some material reflects (mirror or glass)
-    bool refraction = false;  // some material is glass
+    AnalysisParts parts;
     // occluders[light]: objects that may block that light somewhere (their bounds reach
-    // the light's sphere of influence); planes are checked per point by side.
+    // the light's sphere of influence; every object without occludersPerLight or
+    // lightRanges); planes are checked per point by side.
     std::vector<std::vector<int>> occluders;
     std::vector<bool> convex;  // per object: cannot shadow itself
     std::vector<bool> isPlane;
 };
-SceneAnalysis analyzeScene(const Scene& scene);
+SceneAnalysis analyzeScene(const Scene& scene, const AnalysisParts& parts = {});
 
 class Renderer {
 public:

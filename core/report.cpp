@@ -6,6 +6,7 @@
 #include <fstream>
 #include <iomanip>
 #include <sstream>
+#include <stdexcept>
 #include <thread>
 
 #include "core/image.hpp"
@@ -14,6 +15,18 @@ namespace boxes {
 
 Table& Table::row(std::vector<Cell> cells) {
     rows.push_back(std::move(cells));
+    return *this;
+}
+
+Table& Table::timeAndError(std::string median, std::string low, std::string high,
+                           std::string error) {
+    for (const std::string* c : {&median, &low, &high, &error})
+        if (std::find(columns.begin(), columns.end(), *c) == columns.end())
+            throw std::logic_error("table " + id + " has no column '" + *c + "'");
+    timeColumn = std::move(median);
+    timeLowColumn = std::move(low);
+    timeHighColumn = std::move(high);
+    errorColumn = std::move(error);
     return *this;
 }
 
@@ -76,6 +89,9 @@ nlohmann::json Table::toJson() const {
     j["title"] = title;
     j["columns"] = columns;
     j["note"] = note;
+    if (!timeColumn.empty())
+        j["time"] = {{"median", timeColumn}, {"low", timeLowColumn}, {"high", timeHighColumn}};
+    if (!errorColumn.empty()) j["error"] = errorColumn;
     j["rows"] = nlohmann::json::array();
     for (const auto& r : rows) {
         nlohmann::json row = nlohmann::json::array();

@@ -19,8 +19,14 @@ struct Table {
     std::vector<std::string> columns;
     std::vector<std::vector<Cell>> rows;
     std::string note;  // how it was measured, the reference the error is against
+    // A table of variants names the columns of its time (the median and the spread, e.g.
+    // min and max) and of its error against the reference its note states: the report
+    // plots one against the other, and the tests check that no such table shows one side.
+    std::string timeColumn, timeLowColumn, timeHighColumn, errorColumn;
 
     Table& row(std::vector<Cell> cells);
+    // Declares the time and error columns (they must be among `columns`).
+    Table& timeAndError(std::string median, std::string low, std::string high, std::string error);
     void print(std::ostream& out) const;
     nlohmann::json toJson() const;
 };

@@ -208,6 +208,7 @@ function plotHtml(step, spec, opts, args) {
   let plot = null;
   for (const alt of String(spec || "0").split("|")) {
     if (/^\d+$/.test(alt)) plot = plots[Number(alt)];
+    else if (alt === "pareto") plot = plots.find((p) => p.pareto);
     else if (alt.startsWith("~")) {
       const t = alt.slice(1).toLowerCase();
       plot = plots.find((p) => String(p.table).toLowerCase().includes(t) || String(p.title || "").toLowerCase().includes(t));
@@ -262,6 +263,22 @@ function plotHtml(step, spec, opts, args) {
   }
   el.push(`<text x="${(L + W - R) / 2}" y="${H - 8}" text-anchor="middle">${esc(plot.x)}</text>`);
   el.push(`<text x="14" y="${(T + H - B) / 2}" text-anchor="middle" transform="rotate(-90 14 ${(T + H - B) / 2})">${esc(plot.y)}</text>`);
+  // The Pareto front (smaller is better on both axes): a staircase through the points no
+  // other beats on both; the rest get a grey ring, never worth it.
+  const front = [];
+  if (plot.pareto) {
+    for (const p of [...pts].sort((a, b) => a.x - b.x || a.y - b.y)) if (!front.length || p.y < front[front.length - 1].y) front.push(p);
+    const xy = [];
+    front.forEach((p, i) => {
+      if (i) xy.push([ax.map(p.x), ay.map(front[i - 1].y)]);
+      xy.push([ax.map(p.x), ay.map(p.y)]);
+    });
+    el.push(`<polyline points="${xy.map(([x, y]) => `${x.toFixed(1)},${y.toFixed(1)}`).join(" ")}" fill="none" stroke="#57606a" stroke-width="1.5" opacity="0.7"/>`);
+    for (const p of pts) {
+      if (front.some((f) => f.x === p.x && f.y === p.y)) continue;
+      el.push(`<circle cx="${ax.map(p.x).toFixed(1)}" cy="${ay.map(p.y).toFixed(1)}" r="9" fill="none" stroke="#8c959f" stroke-width="1.5"/>`);
+    }
+  }
   const placed = [];
   pts.forEach((p) => {
     const c = colours[series.indexOf(p.s) % colours.length];
@@ -279,7 +296,8 @@ function plotHtml(step, spec, opts, args) {
       el.push(`<text x="${spot[0].toFixed(1)}" y="${(spot[1] + h - 2).toFixed(1)}" fill="${c}">${esc(p.s)}</text>`);
     }
   });
-  const legend = labelPoints ? "" : series.filter(Boolean).map((name, i) => `<span style="color:${colours[i % colours.length]}">●</span> ${esc(name)}`).join(" &nbsp; ");
+  let legend = labelPoints ? "" : series.filter(Boolean).map((name, i) => `<span style="color:${colours[i % colours.length]}">●</span> ${esc(name)}`).join(" &nbsp; ");
+  if (plot.pareto) legend += `${legend ? " &nbsp; " : ""}<span style="color:#57606a">—</span> Pareto front &nbsp; <span style="color:#8c959f">○</span> never worth it (another is better on both)`;
   return (
     `<div class="figure plot"><svg xmlns="http://www.w3.org/2000/svg" width="${W}" height="${H}" viewBox="0 0 ${W} ${H}" font-size="12" font-family="sans-serif" fill="#1f2328">${el.join("")}</svg>` +
     (legend ? `<p class="caption">${legend}</p>` : "") + `</div>`

@@ -2,6 +2,7 @@
 // injected clock, effects on demand, and the program.
 #include <cmath>
 #include <cstring>
+#include <filesystem>
 #include <random>
 
 #include "05_efficiency/bvh_mesh.hpp"
@@ -34,6 +35,124 @@ int maxStep8(const Image& a, const Image& b) {
     int worst = 0;
     for (size_t i = 0; i < x.size(); ++i) worst = std::max(worst, std::abs(int(x[i]) - int(y[i])));
     return worst;
+}
+
+// A sphere as step-supplied geometry that says it is convex: the analysis' self-shadowing
+// rule for geometries, which no built-in scene exercises.
+class ConvexSphereGeometry : public Geometry {
+public:
+    ConvexSphereGeometry(Sphere s, int material) : s_(s), material_(material) {}
+    bool intersect(const Ray& ray, SurfaceHit& hit) const override {
+        auto t = intersectSphere(ray, s_);
+        if (!t) return false;
+        hit.t = *t;
+        hit.point = ray.at(*t);
+        hit.geometricNormal = hit.shadingNormal = (hit.point - s_.centre) / s_.radius;
+        hit.material = material_;
+        hit.primitive = 0;
+        hit.kind = SurfaceHit::Kind::Sphere;
+        hit.u = hit.v = 0.0f;
+        return true;
+    }
+    bool occluded(const Ray& ray) const override { return intersectSphere(ray, s_).has_value(); }
+    Vec3 boundsMin() const override { return s_.centre - Vec3(s_.radius); }
+    Vec3 boundsMax() const override { return s_.centre + Vec3(s_.radius); }
+    bool convex() const override { return true; }
+    std::vector<int> materialsUsed() const override { return {material_}; }
+
+private:
+    Sphere s_;
+    int material_;
+};
+
+// A random scene for the effects-on-demand property: spheres, planes, a closed box mesh and
+// an open sheet of triangles in step 04's hierarchy, a convex geometry, every material
+// (mirrors of reflectance 0 too), lights inside and outside objects, finite and infinite
+// radii, the camera sometimes inside a sphere. The meshes live beside the scene (the
+// hierarchy refers to its mesh).
+struct RandomScene {
+    Scene scene;
+    std::vector<std::unique_ptr<Mesh>> meshes;
+};
+RandomScene randomEffectsScene(std::mt19937_64& rng) {
+    std::uniform_real_distribution<float> u(0.0f, 1.0f);
+    auto in = [&](float a, float b) { return a + (b - a) * u(rng); };
+    auto pick = [&](int n) { return int(rng() % uint64_t(n)); };
+    auto point = [&](float r) { return Vec3(in(-r, r), in(-r, r), in(-r, r)); };
+    RandomScene out;
+    Scene& s = out.scene;
+    s.name = "random";
+    s.materials = {Material::diffuse(Vec3(in(0.2f, 1.0f), in(0.2f, 1.0f), in(0.2f, 1.0f))),
+                   Material::mirror(Vec3(0.9f), in(0.3f, 1.0f)), Material::mirror(Vec3(0.9f), 0.0f),
+                   Material::glass(in(1.1f, 2.0f)), Material::diffuse(Vec3(0.5f))};
+    const int materials = int(s.materials.size());
+    for (int i = 0, n = 1 + pick(4); i < n; ++i)
+        s.spheres.push_back({{point(3.0f), in(0.2f, 1.5f)}, pick(materials)});
+    for (int i = 0, n = pick(3); i < n; ++i) {
+        Vec3 normal = glm::normalize(point(1.0f) + Vec3(0.0f, 1e-3f, 0.0f));
+        s.planes.push_back({{normal, in(-4.0f, 4.0f)}, pick(materials)});
+    }
+    if (pick(2)) {  // a closed box of 12 triangles
+        Mesh& box = *out.meshes.emplace_back(std::make_unique<Mesh>());
+        Vec3 c = point(2.5f), h(in(0.2f, 1.0f), in(0.2f, 1.0f), in(0.2f, 1.0f));
+        for (int k = 0; k < 8; ++k)
+            box.positions.push_back(c + h * Vec3(k & 1 ? 1 : -1, k & 2 ? 1 : -1, k & 4 ? 1 : -1));
+        box.triangles = {{0, 2, 1}, {1, 2, 3}, {4, 5, 6}, {5, 7, 6}, {0, 1, 4}, {1, 5, 4},
+                         {2, 6, 3}, {3, 6, 7}, {0, 4, 2}, {2, 4, 6}, {1, 3, 5}, {3, 7, 5}};
+        box.computeVertexNormals();
+        s.geometries.push_back(std::make_shared<LabBvhMesh>(box, pick(materials)));
+    }
+    if (pick(2)) {  // an open sheet of random triangles
+        Mesh& sheet = *out.meshes.emplace_back(std::make_unique<Mesh>());
+        for (int k = 0, n = 1 + pick(6); k < n; ++k) {
+            Vec3 c = point(3.0f);
+            for (int j = 0; j < 3; ++j) sheet.positions.push_back(c + point(1.0f));
+            uint32_t b = uint32_t(3 * k);
+            sheet.triangles.push_back({b, b + 1, b + 2});
+        }
+        sheet.computeVertexNormals();
+        s.geometries.push_back(std::make_shared<LabBvhMesh>(sheet, pick(materials)));
+    }
+    if (pick(3) == 0)
+        s.geometries.push_back(std::make_shared<ConvexSphereGeometry>(
+            Sphere{point(3.0f), in(0.2f, 1.0f)}, pick(materials)));
+    for (int i = 0, n = 1 + pick(3); i < n; ++i) {
+        PointLight light;
+        // Inside a sphere sometimes (it then lights only that sphere's inside).
+        light.position = pick(4) == 0 ? s.spheres[0].shape.centre : point(5.0f);
+        light.intensity = Vec3(in(0.5f, 30.0f));
+        s.lights.push_back(light);
+    }
+    if (pick(2)) s.setLightRadii();  // finite radii (a ball of influence per light)
+    if (pick(4) == 0) s.lights[0].radius = in(0.5f, 3.0f);
+    Vec3 eye = pick(5) == 0 ? s.spheres[0].shape.centre : point(2.0f) + Vec3(0.0f, 0.0f, 8.0f);
+    s.camera = Camera::lookingAt(eye, point(1.0f) + Vec3(0.0f, 0.0f, 1e-2f), Vec3(0, 1, 0),
+                                 in(30.0f, 90.0f), 4.0f / 3.0f);
+    return out;
+}
+
+// Renders with the analysis and with every part (and one random subset) off: the images
+// must be bit-identical and the analysis may only save rays.
+void checkEffectsIdentity(const Scene& scene, int w, int h, int maxDepth, uint64_t seed) {
+    RenderSettings s;
+    s.width = w;
+    s.height = h;
+    s.maxDepth = maxDepth;
+    s.threads = 1;
+    RayCounts on, off, some;
+    Image a = renderImage(scene, scene.camera, s, &on);
+    s.analysis = AnalysisParts::none();
+    Image b = renderImage(scene, scene.camera, s, &off);
+    s.analysis = {bool(seed & 1), bool(seed & 2), bool(seed & 4), bool(seed & 8)};
+    Image c = renderImage(scene, scene.camera, s, &some);
+    CHECK(bitIdentical(a, b));
+    CHECK(bitIdentical(c, b));
+    CHECK(on.total() <= some.total());
+    CHECK(some.total() <= off.total());
+    // The analysis skips shadow rays only: every other ray is the baseline's.
+    CHECK(on.primary == off.primary);
+    CHECK(on.reflection == off.reflection);
+    CHECK(on.refraction == off.refraction);
 }
 
 double maxErrorOverCircle(const std::function<float(float)>& f, int samples = 200000) {
@@ -519,6 +638,78 @@ TEST_SUITE("renderer 05") {
         CHECK(d.reflection == 0);
         CHECK(d.refraction == 0);
     }
+    TEST_CASE(
+        "effects on demand: every built-in scene and shipped mesh bit-identical against "
+        "the baseline without analysis") {
+        std::vector<std::string> names;
+        for (const auto& [name, what] : builtinScenes()) names.push_back(name);
+        for (const auto& e : std::filesystem::directory_iterator(test::dataDir() + "/meshes"))
+            if (e.path().extension() == ".obj") names.push_back(e.path().string());
+        CHECK(names.size() >= 10);  // eight built-in scenes and two shipped meshes
+        uint64_t subset = 0;
+        for (const std::string& name : names) {
+            INFO(name);
+            Scene scene = makeScene(name, {test::dataDir()});
+            if (scene.hasMesh())
+                scene.geometries.push_back(
+                    std::make_shared<LabBvhMesh>(scene.mesh, scene.meshMaterial));
+            checkEffectsIdentity(scene, 48, 36, 5, subset++);
+        }
+    }
+    TEST_CASE("effects on demand: 200 random scenes bit-identical with fewer or equal rays") {
+        std::mt19937_64 rng(20240607);
+        uint64_t saved = 0, baseline = 0;
+        for (int i = 0; i < 200; ++i) {
+            RandomScene random = randomEffectsScene(rng);
+            const Scene& scene = random.scene;
+            INFO("random scene " << i);
+            checkEffectsIdentity(scene, 20, 15, 1 + i % 5, uint64_t(i));
+            RenderSettings s;
+            s.width = 20;
+            s.height = 15;
+            s.threads = 1;
+            RayCounts on, off;
+            renderImage(scene, scene.camera, s, &on);
+            s.analysis = AnalysisParts::none();
+            renderImage(scene, scene.camera, s, &off);
+            saved += off.total() - on.total();
+            baseline += off.total();
+        }
+        // The property is not vacuous: the analysis does skip rays in these scenes.
+        CHECK(saved > 0);
+        CHECK(saved < baseline);
+    }
+    TEST_CASE(
+        "effects on demand: each part of the analysis saves shadow rays the others do "
+        "not") {
+        // The street of lamps: a lamp's ball reaches only the spheres near it (occluders per
+        // light), the floor lies below every lamp (plane sides), the spheres are convex, and
+        // the far lamps are out of range.
+        Scene scene = makeScene("small-lights", {});
+        RenderSettings s;
+        s.width = 40;
+        s.height = 30;
+        RayCounts all;
+        Image reference = renderImage(scene, scene.camera, s, &all);
+        for (int part = 0; part < 4; ++part) {
+            AnalysisParts allBut;
+            (part == 0   ? allBut.occludersPerLight
+             : part == 1 ? allBut.planeSides
+             : part == 2 ? allBut.convexSelf
+                         : allBut.lightRanges) = false;
+            s.analysis = allBut;
+            RayCounts c;
+            Image img = renderImage(scene, scene.camera, s, &c);
+            INFO("every part but part " << part);
+            CHECK(bitIdentical(img, reference));
+            // On this street the lamps' ranges decide: given them, the other parts find
+            // nothing more to skip (the effects_parts table shows the same).
+            if (part == 3)
+                CHECK(c.shadow > all.shadow);
+            else
+                CHECK(c.shadow >= all.shadow);
+        }
+    }
     TEST_CASE("finite light radius: within one 8-bit sRGB step and fewer evaluations") {
         // Every built-in scene with its default radii (PointLight::cutoffThreshold: half an
         // sRGB step shared by the lights) against infinite radii: the PNGs differ by at most
@@ -715,7 +906,12 @@ TEST_SUITE("program 05") {
         test::checkReportTables(
             dir.file("r.json"),
             {"measuring", "float_double", "acne", "sincos", "early_out", "light_radius", "effects",
-             "precalc", "expensive_ops", "rsqrt", "threads", "antialiasing", "previews", "total"});
+             "precalc", "expensive_ops", "rsqrt", "threads", "antialiasing", "previews", "total",
+             "effects_parts", "effects_identity"});
+        test::checkVariantTables(dir.file("r.json"),
+                                 {"float_double", "acne", "sincos", "early_out", "light_radius",
+                                  "effects", "effects_parts", "precalc", "expensive_ops", "rsqrt",
+                                  "threads", "antialiasing", "previews", "total"});
         CHECK(run.out.find("table nearest 3600") != std::string::npos);
     }
     TEST_CASE("window: previews and refinement under the offscreen video driver") {

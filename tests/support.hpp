@@ -8,6 +8,7 @@
 #include <filesystem>
 #include <fstream>
 #include <limits>
+#include <nlohmann/json.hpp>
 #include <sstream>
 #include <string>
 #include <vector>
@@ -122,6 +123,43 @@ inline void checkReportTables(const std::string& path, std::initializer_list<con
     for (const char* id : ids) {
         INFO(std::string(id));
         CHECK(json.find(std::string("\"") + id + "\"") != std::string::npos);
+    }
+}
+
+// Tables of variants in a step's JSON report: each names a time column with its spread
+// (low, high) and an error column, all among its columns, and every row has numbers there
+// with low <= median <= high. A table showing only its time or only its error fails.
+inline void checkVariantTables(const std::string& path, std::initializer_list<const char*> ids) {
+    nlohmann::json report = nlohmann::json::parse(readText(path));
+    for (const char* id : ids) {
+        INFO("table " << id);
+        const nlohmann::json* table = nullptr;
+        for (const auto& t : report["tables"])
+            if (t["id"] == id) table = &t;
+        REQUIRE(table != nullptr);
+        REQUIRE(table->contains("time"));
+        REQUIRE(table->contains("error"));
+        const auto& columns = (*table)["columns"];
+        auto index = [&](const std::string& name) {
+            for (size_t i = 0; i < columns.size(); ++i)
+                if (columns[i] == name) return i;
+            FAIL("no column '" << name << "'");
+            return size_t(0);
+        };
+        const auto& time = (*table)["time"];
+        size_t median = index(time["median"]), low = index(time["low"]), high = index(time["high"]),
+               error = index((*table)["error"]);
+        CHECK((*table)["note"].get<std::string>().size() > 0);  // states the reference
+        CHECK((*table)["rows"].size() > 0);
+        for (const auto& row : (*table)["rows"]) {
+            INFO(row.dump());
+            REQUIRE(row[median].is_number());
+            REQUIRE(row[low].is_number());
+            REQUIRE(row[high].is_number());
+            CHECK(row[error].is_number());
+            CHECK(row[low].get<double>() <= row[median].get<double>());
+            CHECK(row[median].get<double>() <= row[high].get<double>());
+        }
     }
 }
 

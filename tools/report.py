@@ -62,6 +62,11 @@ def table_html(t):
     )
     head = "".join(f"<th>{html.escape(c)}</th>" for c in t["columns"])
     note = f"<p class=note>{html.escape(t['note'])}</p>" if t.get("note") else ""
+    if t.get("time") and t.get("error"):
+        tm = t["time"]
+        note += (f"<p class=note>Time: <i>{html.escape(tm['median'])}</i> (spread "
+                 f"<i>{html.escape(tm['low'])}</i> to <i>{html.escape(tm['high'])}</i>); error: "
+                 f"<i>{html.escape(t['error'])}</i>, against the reference the note states.</p>")
     return f"<h3>{html.escape(t['title'])}</h3><table><tr>{head}</tr>{rows}</table>{note}"
 
 
@@ -74,6 +79,16 @@ def fmt(c):
             return f"{c:.3g}"
         return f"{c:.1f}" if a >= 100 else f"{c:.4g}"
     return str(c)
+
+
+def pareto_front(points):
+    """The points no other point beats on both axes (smaller is better on each): the
+    variants worth having. points: (x, y) pairs; returns them sorted by x."""
+    front = []
+    for p in sorted(set(points)):
+        if not front or p[1] < front[-1][1]:
+            front.append(p)
+    return front
 
 
 def plot(report, spec, out, name):
@@ -128,13 +143,29 @@ def plot(report, spec, out, name):
         set_scale("symlog", linthresh=min(magnitudes) if magnitudes else 1.0, linscale=0.5)
 
     points = [p for g in groups.values() for p in g]
+    if spec.get("pareto"):
+        # The front as a staircase: right of a point and above it nothing is better.
+        front = pareto_front([p[:2] for p in points])
+        xs, ys = [], []
+        for i, (fx, fy) in enumerate(front):
+            if i:
+                xs.append(fx)
+                ys.append(front[i - 1][1])
+            xs.append(fx)
+            ys.append(fy)
+        ax.plot(xs, ys, "-", color="#333", lw=1.2, alpha=0.6, zorder=0, label="Pareto front")
+        on_front = set(front)
+        dominated = [p for p in points if p[:2] not in on_front]
+        if dominated:
+            ax.plot([p[0] for p in dominated], [p[1] for p in dominated], "o", ms=11,
+                    mfc="none", mec="#999", label="never worth it (another is better on both)")
     scale("x", [p[0] for p in points], spec.get("logx"))
     scale("y", [p[1] for p in points], spec.get("logy"))
     ax.set_xlabel(spec["x"])
     ax.set_ylabel(spec["y"])
     ax.set_title(spec.get("title", table["title"]), fontsize=10, wrap=True)
     ax.grid(True, alpha=0.3)
-    if si is not None and len(groups) > 1:  # below the axes, where it hides no point
+    if (si is not None and len(groups) > 1) or spec.get("pareto"):  # below the axes
         ax.legend(fontsize=8, loc="upper left", bbox_to_anchor=(0.0, -0.16), frameon=False,
                   ncol=2 if short else 1)
     fig.tight_layout()

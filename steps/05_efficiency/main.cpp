@@ -61,6 +61,8 @@ int main(int argc, char** argv) {
         lab.seed = run.options.seed;
         lab.dataDir = run.options.dataDir;
         lab.quick = quick;
+        lab.width = run.settings.width;
+        lab.height = run.settings.height;
         measureLab(run.scene, mesh.get(), lab, report);
     };
 

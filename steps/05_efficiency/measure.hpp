@@ -21,7 +21,8 @@ struct LabOptions {
     int threads = 0;  // for the threads table only: every other table is one thread
     uint64_t seed = 1;
     std::string dataDir;
-    bool quick = false;  // a quarter of the image sizes and far fewer samples (tests)
+    bool quick = false;             // a quarter of the image sizes and far fewer samples (tests)
+    int width = 640, height = 480;  // the run's image size (the identity check of effects)
 };
 
 Table measureMeasuring(const LabOptions& o);    // one call per sample against batches
@@ -30,7 +31,14 @@ Table measureAcne(const LabOptions& o);         // shadow ray self-intersection 
 Table measureSinCos(const LabOptions& o);       // std::sin against tables and a polynomial
 Table measureEarlyOut(LabBvhMesh& mesh, const LabOptions& o);  // step 04's tree
 Table measureLightRadius(const LabOptions& o);
-Table measureEffects(const LabOptions& o);  // effects on demand: analysis on / forced
+// Effects on demand against the fair baseline (zero-weight rays skipped, no analysis):
+// rays and time; each part of the analysis alone and all but it; and every built-in scene
+// and shipped mesh at the run's size, bit-identical (else std::runtime_error).
+Table measureEffects(const LabOptions& o);
+Table measureEffectParts(const LabOptions& o);
+Table measureEffectIdentity(const LabOptions& o);
+// The scenes of the first two: every built-in scene of spheres and planes, and the bunny.
+const std::vector<std::string>& effectsSceneNames();
 Table measurePrecalculation(LabBvhMesh& mesh, const LabOptions& o);
 Table measureExpensiveOps(const LabOptions& o);  // sqrt and division per ray
 Table measureInverseSqrt(const LabOptions& o);

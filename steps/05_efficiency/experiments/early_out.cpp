@@ -16,12 +16,13 @@ Table measureEarlyOut(LabBvhMesh& mesh, const LabOptions& o) {
     t.id = "early_out";
     t.title = "Early out: box and triangle tests per ray and time, with and without";
     t.columns = {"rays",   "method", "count",  "box tests/ray", "triangle tests/ray",
-                 "us/ray", "min us", "max us", "speed-up"};
+                 "us/ray", "min us", "max us", "speed-up",      "answers differing"};
     t.note =
         "the mesh in step 04's hierarchy (full-sweep SAH, leaves of at most 8 triangles), the "
         "lab's own traversal; primary rays of an 80x60 view, shadow rays from their hits to the "
         "light; one thread, median of repeats interleaved round-robin; speed-up: the first row of "
-        "each pair over the second";
+        "each pair over the second; answers differing: rays whose answer (occluded or not; the "
+        "nearest t and triangle) differs from the second row of its pair, the full search";
     const Bounds3f b(mesh.boundsMin(), mesh.boundsMax());
     Camera cam = fitCamera(b.min, b.max, 4.0f / 3.0f);
     CameraBasisT<float> basis = cam.basis();
@@ -56,6 +57,8 @@ Table measureEarlyOut(LabBvhMesh& mesh, const LabOptions& o) {
         {"primary", "every node the ray meets, storage order", &primary, skipOff, false}};
     std::vector<std::function<void()>> passes;
     std::vector<double> boxes, tris;
+    // Each variant's answers, to compare with the full search of its pair.
+    std::vector<std::vector<std::pair<float, int>>> answers;
     for (const Variant& v : variants) {
         auto pass = [&mesh, &v] {
             mesh.setOptions(v.opt);
@@ -69,6 +72,18 @@ Table measureEarlyOut(LabBvhMesh& mesh, const LabOptions& o) {
         const double count = double(std::max<size_t>(1, v.rays->size()));
         boxes.push_back(double(mesh.boxTests()) / count);
         tris.push_back(double(mesh.triangleTests()) / count);
+        mesh.setOptions(v.opt);
+        std::vector<std::pair<float, int>> a;
+        for (const Ray& r : *v.rays) {
+            SurfaceHit hit;
+            if (v.shadows)
+                a.emplace_back(0.0f, int(mesh.occluded(r)));
+            else if (mesh.intersect(r, hit))
+                a.emplace_back(hit.t, hit.primitive);
+            else
+                a.emplace_back(-1.0f, -1);
+        }
+        answers.push_back(std::move(a));
         passes.push_back(pass);
     }
     std::vector<Timing> times = measureInterleaved(o.repeats, passes);
@@ -77,10 +92,14 @@ Table measureEarlyOut(LabBvhMesh& mesh, const LabOptions& o) {
         const Variant& v = variants[i];
         double per = 1e6 / double(std::max<size_t>(1, v.rays->size()));
         size_t first = i - i % 2;
+        long long differ = 0;
+        for (size_t k = 0; k < answers[i].size(); ++k)
+            differ += answers[i][k] != answers[first + 1][k];
         t.row({std::string(v.kind), std::string(v.method), (long long)v.rays->size(), boxes[i],
                tris[i], times[i].median * per, times[i].min * per, times[i].max * per,
-               times[first + 1].median / times[i].median});
+               times[first + 1].median / times[i].median, differ});
     }
+    t.timeAndError("us/ray", "min us", "max us", "answers differing");
     return t;
 }
 

@@ -178,6 +178,7 @@ Table measureExpensiveOps(const LabOptions& o) {
            ms(tn.min), ms(tn.max), 0.0, 0LL});
     t.row({std::string("fewer sqrt and div"), double(cf.sqrt) / n, double(cf.div) / n,
            ms(tf.median), ms(tf.min), ms(tf.max), worst, differing});
+    t.timeAndError("ms/frame", "min ms", "max ms", "max difference");
     return t;
 }
 

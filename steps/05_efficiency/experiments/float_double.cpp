@@ -124,6 +124,7 @@ Table measureFloatDouble(const LabOptions& o) {
                    tD.max * per, 0.0, 0.0, 0.0});
         }
     }
+    t.timeAndError("ns/test", "min ns", "max ns", "max rel t error");
     return t;
 }
 

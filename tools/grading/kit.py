@@ -23,7 +23,7 @@ SKIP_DIRS = {".git", "build", "out", "kit", "node_modules", "__pycache__"}
 # solutions). Their end-to-end tests and unit tests stay out with them.
 GRADER = ("grade", "grade_class", "gradescope", "class_bench")
 NOT_IN_KIT = ({f"tools/grading/{m}.py" for m in GRADER} | {f"tests/tools/test_{m}.py" for m in GRADER}
-              | {"tests/grading_test.py", "tests/class_grading_test.py"})
+              | {"tests/grading_test.py", "tests/class_grading_test.py", "tests/lab_test.py"})
 CLASSROOM_WORKFLOW = ".github/workflows/classroom.yml"  # GitHub Classroom (classroom.py)
 
 

@@ -271,7 +271,10 @@ def fuzz(seconds, artifacts):
         return bytes(data[:1 << 20])
 
     failing = []
-    work = tempfile.mkdtemp(prefix="boxes-fuzz-results-")
+    # Removed when this object goes or the interpreter exits (also after Ctrl-C; SIGTERM
+    # exits through main's handler).
+    scratch = tempfile.TemporaryDirectory(prefix="boxes-fuzz-results-")
+    work = scratch.name
     current = os.path.join(artifacts, "current")
 
     @settings(max_examples=200, database=None, deadline=None, derandomize=False,
@@ -314,6 +317,7 @@ def fuzz(seconds, artifacts):
 
 
 def main(argv):
+    signal.signal(signal.SIGTERM, lambda *_: sys.exit(143))  # exit, so the scratch folders go
     if len(argv) >= 2 and argv[0] == "--replay":
         return replay(argv[1:])
     if len(argv) in (1, 3) and argv[0].isdigit() and (len(argv) == 1 or argv[1] == "--artifacts"):

@@ -12,7 +12,6 @@
 // npm packages are missing (tools/deps.sh slides installs both).
 import { spawnSync } from "node:child_process";
 import fs from "node:fs";
-import os from "node:os";
 import path from "node:path";
 import { fileURLToPath, pathToFileURL } from "node:url";
 
@@ -96,7 +95,11 @@ function inspectSlide() {
   };
 }
 
-const profile = fs.mkdtempSync(path.join(os.tmpdir(), "boxes-slides-chromium-"));
+// Chromium's profile in the build folder, not the shared /tmp: an interrupted check leaves it
+// in the clone, and the next check starts it afresh.
+const profile = path.join(args.bin, "slides-chromium-profile");
+fs.rmSync(profile, { recursive: true, force: true });
+fs.mkdirSync(profile, { recursive: true });
 const context = await playwright.launchPersistentContext(profile, {
   executablePath: chromium,
   headless: true,

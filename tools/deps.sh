@@ -1,11 +1,29 @@
 #!/usr/bin/env bash
 # Installs the Debian packages a workbook command needs, when they are missing.
-# usage: tools/deps.sh GROUP...   (groups: build test report slides fuzz grade bench watch)
-# As root it runs apt-get; otherwise it prints the exact apt-get line and exits 1.
+# usage: tools/deps.sh GROUP...   (groups: build test report slides fuzz grade bench watch, or all)
+# As root it runs apt-get; otherwise it prints what an administrator runs once (the packages
+# are the machine's, for every user) and exits 1. Its logs are private temporary files,
+# removed when it ends, whatever the outcome: several users may run it at once.
 # The group slides also installs the slides' npm packages (Marp, playwright-core) with
 # `npm ci --prefix slides` from slides/package-lock.json when they are missing or stale.
 set -euo pipefail
 root=$(cd "$(dirname "$0")/.." && pwd)
+groups=(build test report slides fuzz grade bench)
+
+logs=""
+cleanup() { [[ -z $logs ]] || rm -rf "$logs"; }
+trap cleanup EXIT
+trap 'exit 130' INT # exit, so the EXIT trap removes the logs
+trap 'exit 143' TERM
+open_log() { # NAME: log=a private log file, in a folder of mktemp's (under TMPDIR or /tmp, mode 0700)
+  [[ -n $logs ]] || logs=$(mktemp -d -t boxes-deps-XXXXXX)
+  log=$logs/$1
+}
+failed() { # what, log: the log's last lines (the log itself goes with this command)
+  echo "[deps] $1 failed; its last lines:" >&2
+  tail -20 "$2" >&2
+  exit 1
+}
 
 pkgs_for() {
   case "$1" in
@@ -30,6 +48,7 @@ pkgs_for() {
       libtinyobjloader-dev libcli11-dev nlohmann-json3-dev
     ;;
   bench) echo libbenchmark-dev libembree-dev python3-numpy linux-perf ;; # perf: step 05 README
+  all) for g in "${groups[@]}"; do pkgs_for "$g"; done ;;
   *)
     echo "tools/deps.sh: unknown group '$1'" >&2
     exit 2
@@ -42,15 +61,13 @@ slides_npm() { # npm ci --prefix slides, when the group slides is asked for and 
   local stamp=$root/slides/node_modules/.package-lock.json
   [[ -f $stamp && ! $root/slides/package-lock.json -nt $stamp ]] && return 0
   echo "[deps] npm ci --prefix slides (Marp and playwright-core, pinned in slides/package-lock.json)" >&2
-  if ! npm ci --prefix "$root/slides" --no-audit --no-fund >/tmp/boxes-npm.log 2>&1; then
-    echo "[deps] npm ci failed; see /tmp/boxes-npm.log" >&2
-    tail -5 /tmp/boxes-npm.log >&2
-    exit 1
-  fi
+  open_log npm.log
+  npm ci --prefix "$root/slides" --no-audit --no-fund >"$log" 2>&1 || failed "npm ci --prefix slides" "$log"
 }
 
 wanted=()
 for group in "$@"; do
+  pkgs_for "$group" >/dev/null || exit 2 # an unknown group (inside $(...) below its exit is lost)
   for p in $(pkgs_for "$group"); do wanted+=("$p"); done
 done
 
@@ -66,20 +83,23 @@ if [[ ${#missing[@]} -eq 0 ]]; then
   exit 0
 fi
 
-line="apt-get install -y --no-install-recommends ${missing[*]}"
 if [[ $(id -u) -ne 0 ]]; then
-  echo "Missing Debian packages. Run as root:" >&2
-  echo "  apt-get update && $line" >&2
+  # An ordinary user (a lab machine's student) cannot install: say what the administrator
+  # runs once, from any clone of the workbook.
+  {
+    echo "[deps] missing Debian packages: ${missing[*]}"
+    echo "[deps] an administrator installs them once, for every user of this machine, with"
+    echo "  sudo tools/deps.sh $*"
+    echo "[deps] (that is: apt-get update && apt-get install -y --no-install-recommends ${missing[*]})"
+    echo "[deps] or everything the workbook uses: sudo tools/deps.sh all"
+  } >&2
   exit 1
 fi
 echo "[deps] installing: ${missing[*]}" >&2
 export DEBIAN_FRONTEND=noninteractive
-if ! apt-get install -y --no-install-recommends "${missing[@]}" >/tmp/boxes-apt.log 2>&1; then
-  apt-get update >>/tmp/boxes-apt.log 2>&1
-  apt-get install -y --no-install-recommends "${missing[@]}" >>/tmp/boxes-apt.log 2>&1 || {
-    echo "[deps] apt-get failed; see /tmp/boxes-apt.log" >&2
-    tail -5 /tmp/boxes-apt.log >&2
-    exit 1
-  }
+open_log apt.log
+if ! apt-get install -y --no-install-recommends "${missing[@]}" >"$log" 2>&1; then
+  apt-get update >>"$log" 2>&1
+  apt-get install -y --no-install-recommends "${missing[@]}" >>"$log" 2>&1 || failed "apt-get install" "$log"
 fi
 slides_npm "$@"

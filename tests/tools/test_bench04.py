@@ -6,6 +6,7 @@ import sys
 import tempfile
 import unittest
 from unittest import mock
+import scratch  # noqa: F401  (tempfile's folders: one, removed at exit)
 
 sys.path.insert(0, os.path.dirname(os.path.dirname(os.path.dirname(os.path.abspath(__file__)))))
 from tools.bench import bench04  # noqa: E402

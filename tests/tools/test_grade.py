@@ -7,6 +7,7 @@ import tempfile
 import time
 import unittest
 import xml.etree.ElementTree as ET
+import scratch  # noqa: F401  (tempfile's folders: one, removed at exit)
 
 sys.path.insert(0, os.path.dirname(os.path.dirname(os.path.dirname(os.path.abspath(__file__)))))
 from tools.grading import class_bench, grade, grade_class, gradescope, sandbox  # noqa: E402

@@ -6,6 +6,7 @@ import sys
 import tempfile
 import unittest
 import zipfile
+import scratch  # noqa: F401  (tempfile's folders: one, removed at exit)
 
 sys.path.insert(0, os.path.dirname(os.path.dirname(os.path.dirname(os.path.abspath(__file__)))))
 from tools.grading import grade_class  # noqa: E402

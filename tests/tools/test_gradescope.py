@@ -4,6 +4,7 @@ import os
 import sys
 import tempfile
 import unittest
+import scratch  # noqa: F401  (tempfile's folders: one, removed at exit)
 
 sys.path.insert(0, os.path.dirname(os.path.dirname(os.path.dirname(os.path.abspath(__file__)))))
 from tools.grading import gradescope  # noqa: E402

@@ -8,6 +8,7 @@ import threading
 import time
 import unittest
 from unittest import mock
+import scratch  # noqa: F401  (tempfile's folders: one, removed at exit)
 
 sys.path.insert(0, os.path.dirname(os.path.dirname(os.path.dirname(os.path.abspath(__file__)))))
 from tools.grading import sandbox  # noqa: E402

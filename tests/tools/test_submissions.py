@@ -7,6 +7,7 @@ import tarfile
 import tempfile
 import unittest
 import zipfile
+import scratch  # noqa: F401  (tempfile's folders: one, removed at exit)
 
 sys.path.insert(0, os.path.dirname(os.path.dirname(os.path.dirname(os.path.abspath(__file__)))))
 from tools.grading import submissions  # noqa: E402

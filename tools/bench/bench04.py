@@ -34,6 +34,7 @@ import os
 import re
 import resource
 import shutil
+import signal
 import statistics
 import struct
 import subprocess
@@ -236,7 +237,13 @@ def main():
     a = ap.parse_args()
     a.data, a.peer_dir = outside_paths(a.data, a.peer_dir)
 
-    work = tempfile.mkdtemp(prefix="boxes-bench04-")
+    # A private scratch folder, removed however the run ends (Ctrl-C, SIGTERM, a failure).
+    signal.signal(signal.SIGTERM, lambda *_: sys.exit(143))
+    with tempfile.TemporaryDirectory(prefix="boxes-bench04-") as work:
+        bench(a, work)
+
+
+def bench(a, work):
     peer_src = os.path.join(work, "peer-bench")
     shutil.copytree(a.peer_dir, peer_src)  # built in a copy: its folder may be read-only
     # Embree's own build script uses -march=native: that is Embree's side, ours stays portable.
@@ -474,7 +481,6 @@ def main():
     with open(a.out, "w") as f:
         json.dump(report, f, indent=1)
     print("wrote " + a.out)
-    shutil.rmtree(work, ignore_errors=True)
 
 
 if __name__ == "__main__":

@@ -17,8 +17,10 @@ program=${3:-$root/build/release/steps/04_bvh/04_bvh}
 [[ -n ${BOXES_PEER_BENCH:-} ]] || { echo "bvh_check.sh: no peer-bench (for make_rays.py): set BOXES_PEER_BENCH to its folder" >&2; exit 2; }
 make_rays=$BOXES_PEER_BENCH/make_rays.py
 [[ -f $make_rays ]] || { echo "bvh_check.sh: BOXES_PEER_BENCH=$BOXES_PEER_BENCH has no make_rays.py" >&2; exit 2; }
-work=$(mktemp -d /tmp/boxes-bvh-check-XXXXXX)
+work=$(mktemp -d -t boxes-bvh-check-XXXXXX) # private (TMPDIR or /tmp), removed however it ends
 trap 'rm -rf "$work"' EXIT
+trap 'exit 130' INT
+trap 'exit 143' TERM
 status=0
 for obj in "$meshes"/*.obj; do
   name=$(basename "$obj" .obj)

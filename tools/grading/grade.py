@@ -31,7 +31,8 @@ failed: <first failing assertion>, does not compile: <first error or the limit i
 The points table goes to the terminal, a JUnit XML file to --junit (default WORK/grade.xml;
 the reason is each failure's message), and with --json FILE the same results per exercise
 as JSON (exercise, title, step, points, max, status, reason, case, seconds).
-WORK/build is kept between runs, so grading the next tree rebuilds only what changed.
+WORK/build is kept between runs, so grading the next tree rebuilds only what changed. The
+test cases run in folders under WORK that go when grading ends: nothing is left in /tmp.
 """
 import argparse
 import contextlib
@@ -40,6 +41,7 @@ import json
 import os
 import re
 import shutil
+import signal
 import stat
 import subprocess
 import sys
@@ -300,7 +302,7 @@ def check_user_access(iso, work, secret):
     src = os.path.join(work, "src")
     wanted = [src, os.path.join(src, "CMakeLists.txt")]
     paths = wanted + [p for p in secret if p and os.path.exists(p)]
-    with tempfile.TemporaryDirectory(prefix="boxes-probe-") as folder:
+    with tempfile.TemporaryDirectory(prefix="probe-", dir=work) as folder:
         os.chmod(folder, 0o711)
         os.chown(folder, iso.user.uid, iso.user.gid)
         r = sandbox.run([sandbox.USER_PYTHON, "-I", "-S", "-c", _ACCESS_PROBE] + paths,
@@ -805,7 +807,9 @@ def grade(student, opts, out=None, log=None, deadline=None, partial=False):
         notes.append("student code ran without isolation (--no-isolation)")
     configure(work, iso)
     rows = []
-    with tempfile.TemporaryDirectory(prefix="boxes-grade-") as scratch:
+    # The test cases' folders: in WORK (the clone's build/ by default), not the shared /tmp,
+    # and removed when grading ends, however it ends.
+    with tempfile.TemporaryDirectory(prefix="scratch-", dir=work, ignore_cleanup_errors=True) as scratch:
         if iso.drop:
             os.chmod(scratch, 0o711)  # the user reaches its case folders, lists nothing
         for k, number in enumerate(steps):
@@ -922,6 +926,10 @@ def grade_into(folder, tree, opts, limit=None, partial=False):
     return Report(0, time.monotonic() - started, results_by_exercise(graded.rows), graded.notes, last)
 
 
+def _interrupted(signum, frame):
+    raise KeyboardInterrupt
+
+
 def main(argv):
     defaults = GradeOptions()
     p = argparse.ArgumentParser(prog="./workbook grade", description=__doc__.split("\n\n")[0],
@@ -956,6 +964,8 @@ def main(argv):
     opts = GradeOptions(**{f.name: getattr(args, f.name) for f in dataclasses.fields(GradeOptions)
                            if hasattr(args, f.name)})
     opts.steps = args.steps
+    # SIGTERM as Ctrl-C: an exception, so the sandboxed command is killed and the scratch goes.
+    signal.signal(signal.SIGTERM, _interrupted)
     try:
         grade(args.student, opts)
     except GradeError as e:

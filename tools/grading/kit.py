@@ -26,7 +26,8 @@ SKIP_DIRS = {".git", "build", "out", "kit", "node_modules", "__pycache__"}
 # solutions). Their end-to-end tests and unit tests stay out with them.
 GRADER = ("grade", "grade_class", "gradescope", "class_bench", "mutants")
 NOT_IN_KIT = ({f"tools/grading/{m}.py" for m in GRADER} | {f"tests/tools/test_{m}.py" for m in GRADER}
-              | {"tests/grading_test.py", "tests/class_grading_test.py", "tests/check_test.py"})
+              | {"tests/grading_test.py", "tests/class_grading_test.py", "tests/check_test.py",
+                 "tests/lab_test.py"})
 # The catalogue of students' mistakes (tools/grading/mutants.py): patches of the solutions.
 NOT_IN_KIT_DIRS = ("tests/mutants/",)
 

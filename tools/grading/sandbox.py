@@ -675,7 +675,8 @@ def main(argv):
     p.add_argument("--output", type=decimal(0, MAX_MB), default=16.0, help="MB printed, and per file written (default 16)")
     p.add_argument("--processes", type=integer(1, 1 << 20), default=256,
                    help="processes and threads at once (default 256)")
-    p.add_argument("--dir", help="the writable working folder (default: a new temporary one)")
+    p.add_argument("--dir", help="the writable working folder (default: a new one in the "
+                   "clone's build/sandbox/, kept for its stdout.txt and stderr.txt)")
     p.add_argument("--no-isolation", action="store_true", help="limits only, no bubblewrap (trusted code)")
     p.add_argument("--user", help="with --no-isolation, as root: run as this unprivileged user and kill "
                                   "every process of it afterwards")
@@ -709,8 +710,15 @@ def main(argv):
             print(f"sandbox: {problem}; refusing to run untrusted code without isolation "
                   "(--no-isolation to force)", file=sys.stderr)
             return 2
-    folder = args.dir or tempfile.mkdtemp(prefix="boxes-sandbox-")
-    os.makedirs(folder, exist_ok=True)
+    if args.dir:
+        folder = args.dir
+        os.makedirs(folder, exist_ok=True)
+    else:  # kept for the outputs, so in the clone (build/), never in the shared /tmp
+        runs = os.path.join(os.path.dirname(os.path.dirname(os.path.dirname(os.path.abspath(__file__)))),
+                            "build", "sandbox")
+        os.makedirs(runs, exist_ok=True)
+        folder = tempfile.mkdtemp(prefix="run-", dir=runs)
+        print(f"sandbox: the command's folder: {folder}", file=sys.stderr)
     if user:
         os.chown(folder, user.uid, user.gid)
     r = run(cmd, Limits(args.time, args.memory, args.output, processes=args.processes),

@@ -2,8 +2,8 @@
 # Runs one untrusted command isolated and limited (for the grader: student builds and tests).
 # usage: tools/grading/sandbox.sh [--time SECONDS] [--memory MB] [--output MB] [--processes N]
 #                                 [--dir DIR] [--no-isolation [--user NAME]] -- COMMAND [ARGS...]
-# Isolation (bubblewrap): the whole system read-only, DIR (default: a fresh temporary
-# folder) the only writable place and the working directory, a private /tmp, no network,
+# Isolation (bubblewrap): the whole system read-only, DIR (default: a fresh folder in the
+# clone's build/sandbox/) the only writable place and the working directory, a private /tmp, no network,
 # own PID and user namespace without capabilities, killed with this script. Limits:
 # wall-clock seconds, CPU seconds, address space, output and the size of any file written.
 # The command's stdout and stderr go to DIR/stdout.txt and DIR/stderr.txt (bounded by the

@@ -1,0 +1,287 @@
+#!/usr/bin/python3
+"""The computer lab (ctest label "lab"): packages installed once by an administrator, every
+student an ordinary user with a clone of their own.
+
+usage: tests/lab_test.py WORK_DIR   (as root: it creates two users; skipped, 77, otherwise)
+
+As root, with a root-owned file already at every fixed /tmp path the workbook once used
+(FIXED_PATHS), it creates two unprivileged users, gives each a fresh clone of this tree in
+their home, configures it once (-O1, as the grader builds), then runs COMMANDS as both users
+at the same time (setpriv, a clean environment): the tour of one step and that step's tests
+(both users), and grading the clone (the first user). Every command must succeed, and after
+each one the user owns nothing new in /tmp, /var/tmp or /dev/shm. Then, with stand-ins for dpkg-query and npm on
+PATH (no network, no install): a missing package names what the administrator runs once;
+npm's log goes nowhere shared (the old /tmp log broke the second user); a failing npm shows
+its output; Ctrl-C during npm leaves nothing behind. The users and their homes are removed
+at the end.
+"""
+import hashlib
+import os
+import pwd
+import resource
+import shutil
+import signal
+import subprocess
+import sys
+import threading
+import time
+
+ROOT = os.path.dirname(os.path.dirname(os.path.abspath(__file__)))
+sys.path.insert(0, ROOT)
+from tools.grading.kit import tracked_files  # noqa: E402
+
+SKIPPED = 77
+STEP = "01"
+# The fixed paths the commands once wrote (tools/deps.sh's logs): each gets a root-owned file,
+# which an ordinary user can neither replace nor write.
+FIXED_PATHS = ["/tmp/boxes-apt.log", "/tmp/boxes-npm.log"]
+SHARED_TEMP = ["/tmp", "/var/tmp", "/dev/shm"]
+GRADING = os.path.exists(os.path.join(ROOT, "tools", "grading", "grade.py"))  # not in a kit
+# What the users run, in order, in their clones: (name, command, both). One line per command.
+# both: the two users at once; the grader's build is a second build of the core, so one user
+# grades (while the other still builds and tests) to keep the test cheap on two cores.
+COMMANDS = [
+    ("tour", ["./workbook", "tour", "--steps", STEP], True),
+    ("test", ["./workbook", "test", "--steps", STEP], True),
+] + ([("grade", ["./workbook", "grade", ".", "--steps", STEP, "--timeout", "20"], False)] if GRADING else [])
+
+failures = []
+lock = threading.Lock()
+
+
+def check(condition, message):
+    with lock:
+        print(("ok    " if condition else "FAIL  ") + message, flush=True)
+        if not condition:
+            failures.append(message)
+
+
+def user_names(work):
+    """Two names of this work folder's own: runs in other trees do not share them."""
+    tag = hashlib.sha1(os.path.abspath(work).encode()).hexdigest()[:7]
+    return [f"boxes-lab{tag}{c}" for c in "ab"]
+
+
+def processes_of(uid):
+    found = []
+    for entry in os.listdir("/proc"):
+        if entry.isdigit():
+            try:
+                with open(f"/proc/{entry}/status") as f:
+                    fields = dict(line.split(":", 1) for line in f if ":" in line)
+                if uid in map(int, fields["Uid"].split()[:2]) and fields["State"].split()[0] not in "ZX":
+                    found.append(int(entry))
+            except (OSError, KeyError, ValueError):
+                pass
+    return found
+
+
+def remove_user(name):
+    try:
+        uid = pwd.getpwnam(name).pw_uid
+    except KeyError:
+        return
+    for pid in processes_of(uid):
+        try:
+            os.kill(pid, signal.SIGKILL)
+        except ProcessLookupError:
+            pass
+    subprocess.run(["userdel", "-r", name], capture_output=True)
+
+
+def owned_in_temp(uid):
+    """What the user owns at the top of the shared temporary folders."""
+    found = set()
+    for folder in SHARED_TEMP:
+        try:
+            names = os.listdir(folder)
+        except OSError:
+            continue
+        for n in names:
+            try:
+                if os.lstat(os.path.join(folder, n)).st_uid == uid:
+                    found.add(os.path.join(folder, n))
+            except OSError:
+                pass
+    return found
+
+
+class User:
+    def __init__(self, name):
+        subprocess.run(["useradd", "--create-home", "--shell", "/bin/bash", name], check=True,
+                       capture_output=True)
+        self.pw = pwd.getpwnam(name)
+        self.name, self.home = name, self.pw.pw_dir
+        self.clone = os.path.join(self.home, "boxes")
+
+    def env(self, **extra):
+        """A login's plain environment: no TMPDIR, nothing of this test's."""
+        env = dict(PATH="/usr/local/bin:/usr/bin:/bin", HOME=self.home, USER=self.name,
+                   LOGNAME=self.name, LANG="C.UTF-8")
+        env.update(extra)
+        return env
+
+    def popen(self, cmd, cwd=None, **extra):
+        return subprocess.Popen(["setpriv", f"--reuid={self.pw.pw_uid}", f"--regid={self.pw.pw_gid}",
+                                 "--init-groups", "--"] + cmd, cwd=cwd or self.clone, env=self.env(**extra),
+                                stdout=subprocess.PIPE, stderr=subprocess.STDOUT, text=True,
+                                start_new_session=True)
+
+    def run(self, cmd, timeout=900, **extra):
+        p = self.popen(cmd, **extra)
+        try:
+            out, _ = p.communicate(timeout=timeout)
+        except subprocess.TimeoutExpired:
+            os.killpg(p.pid, signal.SIGKILL)
+            out, _ = p.communicate()
+            return 124, out
+        return p.returncode, out
+
+
+def make_clone(user):
+    """A fresh clone of this tree (as it is on disk: uncommitted edits too) that the user owns."""
+    subprocess.run(["git", "clone", "--quiet", "--no-hardlinks", ROOT, user.clone], check=True)
+    for rel in tracked_files(ROOT):
+        dest = os.path.join(user.clone, rel)
+        os.makedirs(os.path.dirname(dest), exist_ok=True)
+        shutil.copy2(os.path.join(ROOT, rel), dest)
+    subprocess.run(["chown", "-R", f"{user.name}:{user.name}", user.clone], check=True)
+
+
+def tail(text, n=30):
+    return "\n".join(text.splitlines()[-n:])
+
+
+def scenario(user, first):
+    """Configure once, then COMMANDS in order (the first user all of them, the other those
+    both run); each succeeds and leaves nothing in /tmp."""
+    before = owned_in_temp(user.pw.pw_uid)
+    check(not before, f"{user.name}: owns nothing in {', '.join(SHARED_TEMP)} before: {sorted(before)}")
+    rc, out = user.run(["cmake", "--preset", "release", "-DCMAKE_CXX_FLAGS_RELEASE=-O1 -DNDEBUG"])
+    check(rc == 0, f"{user.name}: configures its clone ({tail(out, 5)})")
+    for name, cmd, both in COMMANDS:
+        if not (first or both):
+            continue
+        started = time.monotonic()
+        rc, out = user.run(cmd)
+        left = owned_in_temp(user.pw.pw_uid) - before
+        seconds = time.monotonic() - started
+        if rc != 0:
+            print(f"--- {user.name}: {' '.join(cmd)}\n{tail(out)}", flush=True)
+        check(rc == 0, f"{user.name}: {' '.join(cmd)} succeeds as an ordinary user ({seconds:.0f} s, exit {rc})")
+        check(not left, f"{user.name}: {name} leaves nothing of its own in the shared temporary folders: {sorted(left)}")
+        if name == "tour":
+            check(os.path.exists(os.path.join(user.clone, "out", "index.html")),
+                  f"{user.name}: the tour wrote out/index.html in its clone")
+
+
+def write_script(path, text, owner):
+    with open(path, "w") as f:
+        f.write(text)
+    os.chmod(path, 0o755)
+    os.chown(path, owner.pw.pw_uid, owner.pw.pw_gid)
+
+
+def deps_scenario(user):
+    """tools/deps.sh as an ordinary user with stand-ins for dpkg-query (a package missing on
+    request) and npm (succeeds, fails or hangs on request)."""
+    fake = os.path.join(user.home, "fake-bin")
+    os.makedirs(fake, exist_ok=True)
+    os.chown(fake, user.pw.pw_uid, user.pw.pw_gid)
+    write_script(os.path.join(fake, "dpkg-query"),
+                 '#!/bin/sh\nfor p; do :; done\n'
+                 'case " $FAKE_MISSING " in *" $p "*) exit 1 ;; esac\n'
+                 "printf 'install ok installed'\n", user)
+    write_script(os.path.join(fake, "npm"),
+                 '#!/bin/sh\necho "npm stand-in: $*"\ntouch "$HOME/npm-ran"\n'
+                 '[ -n "$FAKE_NPM_FAIL" ] && { echo "npm stand-in: E404 no such package"; exit 1; }\n'
+                 '[ -n "$FAKE_NPM_SLOW" ] && { mkdir -p "$HOME/npm-started"; sleep 60; }\nexit 0\n', user)
+    path = f"{fake}:/usr/local/bin:/usr/bin:/bin"
+    uid = user.pw.pw_uid
+    deps = ["tools/deps.sh"]
+
+    rc, out = user.run(deps + ["build", "test"], PATH=path, FAKE_MISSING="libglm-dev xvfb")
+    check(rc == 1 and "sudo tools/deps.sh build test" in out and "sudo tools/deps.sh all" in out
+          and "apt-get install -y --no-install-recommends libglm-dev xvfb" in out,
+          f"deps.sh, packages missing: names what the administrator runs once and the packages ({tail(out, 6)})")
+    check(not owned_in_temp(uid), "deps.sh, packages missing: nothing left in /tmp")
+
+    shutil.rmtree(os.path.join(user.clone, "slides", "node_modules"), ignore_errors=True)
+    rc, out = user.run(deps + ["slides"], PATH=path)
+    ran = os.path.exists(os.path.join(user.home, "npm-ran"))
+    check(rc == 0 and ran and "failed" not in out,
+          f"deps.sh slides, npm succeeds, root-owned {FIXED_PATHS[1]} there: it succeeds ({tail(out, 4)})")
+    check(not owned_in_temp(uid), "deps.sh slides: npm's log left nothing in /tmp")
+
+    rc, out = user.run(deps + ["slides"], PATH=path, FAKE_NPM_FAIL="1")
+    check(rc == 1 and "npm ci --prefix slides failed" in out and "E404 no such package" in out,
+          f"deps.sh slides, npm fails: exit 1 with npm's last lines ({tail(out, 4)})")
+    check(not owned_in_temp(uid), "deps.sh slides, npm fails: its log is gone from /tmp")
+
+    # Ctrl-C while npm runs: SIGINT to the whole foreground process group, as a terminal sends it.
+    started = os.path.join(user.home, "npm-started")
+    shutil.rmtree(started, ignore_errors=True)
+    p = user.popen(deps + ["slides"], PATH=path, FAKE_NPM_SLOW="1")
+    deadline = time.monotonic() + 60
+    while not os.path.exists(started) and time.monotonic() < deadline and p.poll() is None:
+        time.sleep(0.1)
+    during = owned_in_temp(uid)
+    os.killpg(p.pid, signal.SIGINT)
+    try:
+        p.communicate(timeout=30)
+    except subprocess.TimeoutExpired:
+        os.killpg(p.pid, signal.SIGKILL)
+        p.communicate()
+    check(os.path.exists(started) and during, f"deps.sh slides, Ctrl-C: npm was running, its log in {sorted(during)}")
+    check(p.returncode != 0 and not owned_in_temp(uid),
+          f"deps.sh slides, Ctrl-C: it stops (exit {p.returncode}) and leaves nothing in /tmp")
+
+
+def main():
+    if len(sys.argv) != 2:
+        print(__doc__.split("\n\n")[1], file=sys.stderr)
+        return 2
+    work = os.path.abspath(sys.argv[1])
+    if os.geteuid() != 0:
+        print("SKIP: creating the lab's users needs root")
+        return SKIPPED
+    for tool in ("useradd", "userdel", "setpriv"):
+        if not shutil.which(tool):
+            print(f"FAIL: {tool} is missing (util-linux, passwd)")
+            return 1
+    names = user_names(work)
+    placed = []
+    users = []
+    try:
+        for path in FIXED_PATHS:
+            if not os.path.exists(path):
+                with open(path, "w") as f:
+                    f.write("root's, from an earlier run\n")
+                os.chmod(path, 0o644)
+                placed.append(path)
+            check(os.lstat(path).st_uid == 0, f"{path} is root's: an ordinary user cannot write it")
+        for name in names:
+            remove_user(name)  # a leftover of an interrupted run
+            users.append(User(name))
+            make_clone(users[-1])
+        threads = [threading.Thread(target=scenario, args=(u, u is users[0])) for u in users]
+        started = time.monotonic()
+        for t in threads:
+            t.start()
+        for t in threads:
+            t.join()
+        cpu = resource.getrusage(resource.RUSAGE_CHILDREN)
+        print(f"both users: {time.monotonic() - started:.0f} s, {cpu.ru_utime + cpu.ru_stime:.0f} s of CPU",
+              flush=True)
+        deps_scenario(users[0])
+    finally:
+        for name in names:
+            remove_user(name)
+        for path in placed:
+            os.remove(path)
+    print(f"{len(failures)} failed" if failures else "all passed")
+    return 1 if failures else 0
+
+
+if __name__ == "__main__":
+    sys.exit(main())

@@ -8,7 +8,7 @@
 # `npm ci --prefix slides` from slides/package-lock.json when they are missing or stale.
 set -euo pipefail
 root=$(cd "$(dirname "$0")/.." && pwd)
-groups=(build test report slides fuzz grade bench)
+groups=(build test report slides fuzz grade bench watch)
 
 logs=""
 cleanup() { [[ -z $logs ]] || rm -rf "$logs"; }

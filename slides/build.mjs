@@ -18,7 +18,7 @@
 //   <!-- table: 01_triangle/ID|~text|* [columns=a|b] [rows=N] [dense] -->
 //                                                     a measured table (first alternative found)
 //   <!-- plot: 01_triangle/N [w=560] [h=330] -->        the report's plot N, drawn as inline SVG
-//   <!-- fact: 01_triangle/name -->                   one number from the report's facts
+//   <!-- fact: 01_triangle/name -->                   one number from the report's facts (also inline)
 //   <!-- machine -->                                  the machine the deck's numbers come from
 //   <!-- exercises: 01_triangle -->                  the step's exercise markers as a table
 //   <!-- code: 01_triangle NAME|EXERCISE 1.4 [max=N] [nocomments] -->
@@ -475,6 +475,8 @@ function expand(markdown, deck, args, deckDir) {
   const deckStep = /^\d\d_/.test(deck) ? deck : null;
   // Stated outcomes' checks (slides/claims.mjs reads them) are for the test, not the notes.
   markdown = markdown.replace(/^[ \t]*<!--\s*check:.*?-->[ \t]*\r?\n/gm, "");
+  // A fact may stand inside a sentence: "<!-- fact: 02_box/random_rays --> rays".
+  markdown = markdown.replace(/<!--\s*fact:?\s*(\d\d_[A-Za-z0-9_]+)\/(\S+?)\s*-->/g, (_, step, name) => factText(step, name, args));
   return markdown.replace(/^[ \t]*<!--\s*(image|table|plot|fact|machine|code|exercises):?\s*(.*?)\s*-->[ \t]*$/gm, (_, kind, rest) => {
     const words = [...rest.matchAll(/(\w+)="([^"]*)"|(\S+)/g)].map((m) => (m[3] !== undefined ? m[3] : `${m[1]}=${m[2]}`));
     if (kind === "machine") return machineHtml(deckStep, args);

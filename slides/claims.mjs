@@ -146,8 +146,7 @@ function main() {
           console.log(`FAIL ${where}: ${e.message}`);
         }
       }
-      const fact = line.match(/^\s*<!--\s*fact:?\s*(\d\d_[A-Za-z0-9_]+)\/(\S+)\s*-->\s*$/);
-      if (fact) {
+      for (const fact of line.matchAll(/<!--\s*fact:?\s*(\d\d_[A-Za-z0-9_]+)\/(\S+?)\s*-->/g)) {
         try {
           resolve(fact[1], "facts", undefined, fact[2]);
           ++passed;

@@ -18,6 +18,7 @@
 #include "core/mesh.hpp"
 #include "core/render.hpp"
 #include "core/scene.hpp"
+#include "step04_support.hpp"
 #include "support.hpp"
 
 using namespace boxes;

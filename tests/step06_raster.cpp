@@ -747,6 +747,10 @@ TEST_SUITE("program 06") {
         test::runWindowScript(program, dir, "--scene sh1 --width 64 --height 48", 8,
                               "r,d,h,b,p,f,Left");
     }
+    TEST_CASE("window: the textured floor rasterized and ray traced under the offscreen driver") {
+        test::TempDir dir;
+        test::runWindowScript(program, dir, "--floor-texture --width 64 --height 48", 6, "p,r");
+    }
     TEST_CASE("bad input: one clear line and a non-zero exit") {
         test::TempDir dir;
         std::ofstream(dir.file("nan.obj")) << "v 0 0 0\nv 1 nan 0\nv 0 1 0\nf 1 2 3\n";

@@ -110,6 +110,7 @@ int main(int argc, char** argv) {
     // The window: rasterizer, ray tracer, or their difference (viewer.hpp).
     step.openWindow = [&](StepRun& run) {
         viewer = std::make_unique<RasterViewer>(run.scene, view, run.settings);
+        if (floor) viewer->textureFrame = &floor->frame;
     };
     step.keys = RasterViewer::keys();
     step.onKey = [&](StepRun&, int key) { return viewer->onKey(key); };

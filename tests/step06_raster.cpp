@@ -725,14 +725,31 @@ TEST_SUITE("program 06") {
     TEST_CASE("measurements: the JSON report has the step's tables") {
         test::TempDir dir;
         test::runHeadless(program, dir, 48, 36, "--measure --report r.json");
-        test::checkReportTables(dir.file("r.json"), {"visibility", "frame_time", "shadow_bias",
-                                                     "shadows", "interpolation", "culling"});
+        test::checkReportTables(dir.file("r.json"),
+                                {"visibility", "frame_time", "shadow_bias", "shadows",
+                                 "interpolation", "culling", "vertex_precalc", "texture"});
+        test::checkVariantTables(dir.file("r.json"), {"vertex_precalc", "texture"});
         CHECK(test::pngSize(dir.file("a-affine.png")) == std::pair{48, 36});
+        for (const char* png : {"a-texture.png", "a-texture-affine.png", "a-texture-traced.png"})
+            CHECK(test::pngSize(dir.file(png)) == std::pair{48, 36});
+    }
+    TEST_CASE("the textured floor: perspective-correct shows the ray tracer's texels") {
+        test::TempDir dir;
+        auto run = test::runHeadless(program, dir, 64, 48, "--floor-texture --compare");
+        CHECK(test::pngSize(dir.file("a-traced.png")) == std::pair{64, 48});
+        CHECK(run.out.find("textured floor (perspective-correct): 0 of ") != std::string::npos);
+        auto affine = test::runHeadless(program, dir, 64, 48, "--floor-texture --affine --compare");
+        CHECK(affine.out.find("textured floor (affine): ") != std::string::npos);
+        CHECK(affine.out.find("textured floor (affine): 0 of ") == std::string::npos);
     }
     TEST_CASE("window: scripted frames with key presses under the offscreen video driver") {
         test::TempDir dir;
         test::runWindowScript(program, dir, "--scene sh1 --width 64 --height 48", 8,
                               "r,d,h,b,p,f,Left");
+    }
+    TEST_CASE("window: the textured floor rasterized and ray traced under the offscreen driver") {
+        test::TempDir dir;
+        test::runWindowScript(program, dir, "--floor-texture --width 64 --height 48", 6, "p,r");
     }
     TEST_CASE("bad input: one clear line and a non-zero exit") {
         test::TempDir dir;

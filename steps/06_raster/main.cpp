@@ -5,6 +5,7 @@
 
 #include "06_raster/frame.hpp"
 #include "06_raster/measure.hpp"
+#include "06_raster/texture.hpp"
 #include "06_raster/viewer.hpp"
 #include "core/step.hpp"
 
@@ -14,7 +15,8 @@ int main(int argc, char** argv) {
     CLI::Option *nearOption = nullptr, *farOption = nullptr;
     double nearFlag = 0.0, farFlag = 0.0;
     std::string idsPath, depthPath, shadows = "rays";
-    bool affine = false, compare = false, measure = false, noCull = false;
+    bool affine = false, compare = false, measure = false, noCull = false, floorTexture = false;
+    std::optional<TexturedFloor> floor;  // with --floor-texture
     RasterSettings rs;
     ShadeSettings shading;
     RasterView view;  // the scene as triangles, its culler, the settings (frame.hpp)
@@ -54,15 +56,28 @@ int main(int argc, char** argv) {
                      "interpolate affinely in screen space (warps) instead of with 1/w");
         app.add_flag("--checker", shading.checker,
                      "modulate the surfaces with a checker (shows interpolation)");
+        app.add_flag("--floor-texture", floorTexture,
+                     "draw the textured floor instead of --scene: a 20 x 20 texel checker from "
+                     "texture coordinates on a quad seen at a low angle (with --affine: the "
+                     "screen-linear version; with --compare: FILE-traced.png, the ray tracer's)");
         app.add_flag(
             "--compare", compare,
             "also ray trace the view and print how the two agree (and write FILE-diff.png)");
         app.add_flag("--measure", measure, "run the step's measurements and print the tables");
     };
+    // --floor-texture: the floor's scene and camera (the camera flags still apply).
+    step.makeScene = [&](const CommonOptions& o) {
+        if (!floorTexture) return sceneFromOptions(o);
+        floor = texturedFloor(o.aspect());
+        Scene scene = floor->scene;
+        scene.camera = cameraFromOptions(o, scene.camera);
+        return scene;
+    };
     // The ray tracer sees the mesh through step 01's grid; the rasterizer its triangles.
     step.addGeometry = [&](StepRun& run) {
         attachGrid(run.scene);
         view = RasterView(run.scene);
+        if (floor) attachTexcoords(view.scene, floor->frame);
         setClipPlanes(rs, nearOption->count() ? std::optional(nearFlag) : std::nullopt,
                       farOption->count() ? std::optional(farFlag) : std::nullopt);
         rs.width = run.options.width;
@@ -73,6 +88,7 @@ int main(int argc, char** argv) {
         shading.shadows = shadows == "none"  ? ShadowMode::None
                           : shadows == "map" ? ShadowMode::Map
                                              : ShadowMode::Rays;
+        shading.texture = shading.texture || floorTexture;
         view.shading = shading;
         view.culling = !noCull;
     };
@@ -87,12 +103,14 @@ int main(int argc, char** argv) {
     };
     step.measure = [&](StepRun& run, Report& report) {
         if (compare) compareWithRayTracer(run, view, frame, report);
+        if (compare && floor) compareTextureWithRayTracer(run, *floor, view, frame, report);
         if (measure) measureRaster(run, report);
     };
 
     // The window: rasterizer, ray tracer, or their difference (viewer.hpp).
     step.openWindow = [&](StepRun& run) {
         viewer = std::make_unique<RasterViewer>(run.scene, view, run.settings);
+        if (floor) viewer->textureFrame = &floor->frame;
     };
     step.keys = RasterViewer::keys();
     step.onKey = [&](StepRun&, int key) { return viewer->onKey(key); };

@@ -8,6 +8,7 @@
 #include "01_triangle/triangle_grid.hpp"
 #include "04_bvh/trace.hpp"
 #include "06_raster/culling.hpp"
+#include "06_raster/texture.hpp"
 #include "core/render.hpp"
 #include "core/timing.hpp"
 
@@ -346,6 +347,139 @@ Table measureInterpolation(const MeasureView& bunny, const MeasureSettings& m,
     return t;
 }
 
+namespace {
+
+// Times each variant `repeats` times, one frame of each per round, so a change in the
+// machine's load affects every variant alike.
+std::vector<Timing> timeInterleaved(int repeats, const std::vector<std::function<void()>>& fns) {
+    std::vector<std::vector<double>> samples(fns.size());
+    for (int r = 0; r < repeats; ++r)
+        for (size_t k = 0; k < fns.size(); ++k) {
+            Stopwatch watch;
+            fns[k]();
+            samples[k].push_back(watch.seconds());
+        }
+    std::vector<Timing> times;
+    for (auto& s : samples) times.push_back(summarize(s));
+    return times;
+}
+
+size_t buffersDiffering(const FrameBuffers& a, const FrameBuffers& b) {
+    size_t n = 0;
+    for (size_t i = 0; i < a.depth.size(); ++i)
+        n += a.triangle[i] != b.triangle[i] || a.depth[i] != b.depth[i] ||
+             a.weight1[i] != b.weight1[i] || a.weight2[i] != b.weight2[i];
+    return n;
+}
+
+}  // namespace
+
+Table measureVertexPrecalc(const std::vector<MeasureView>& views, const MeasureSettings& m) {
+    Table t;
+    t.id = "vertex_precalc";
+    t.title =
+        "Precalculation: the vertex work done once per vertex, per triangle corner, per pixel";
+    t.columns = {"view",
+                 "vertex work",
+                 "ms/frame",
+                 "min ms",
+                 "max ms",
+                 "speed-up",
+                 "vertex transforms",
+                 "transforms per vertex",
+                 "pixels differing"};
+    t.note = std::to_string(m.width) + "x" + std::to_string(m.height) +
+             ", rasterizing only (no shading), one thread, median of " +
+             std::to_string(m.repeats + 2) +
+             " frames interleaved; vertex work: the transform to clip space (and per pixel also "
+             "the divide by w and the viewport); speed-up against per pixel; pixels differing: "
+             "triangle, depth or weights differ from the once-per-vertex frame's, bit for bit";
+    const VertexWork works[] = {VertexWork::PerPixel, VertexWork::PerCorner,
+                                VertexWork::OncePerVertex};
+    for (const MeasureView& v : views) {
+        std::cerr << "06_raster: vertex work on " << v.name << "...\n";
+        RasterScene raster = RasterScene::fromScene(v.scene);
+        std::vector<FrameBuffers> buffers(3);
+        std::vector<FrameStats> stats(3);
+        std::vector<std::function<void()>> frames;
+        for (size_t k = 0; k < 3; ++k)
+            frames.push_back([&, k] {
+                RasterSettings rs = rasterSettings(m);
+                rs.vertexWork = works[k];
+                stats[k] = rasterizeFrame(raster, v.camera, rs, buffers[k]);
+            });
+        std::vector<Timing> times = timeInterleaved(m.repeats + 2, frames);
+        for (size_t k = 0; k < 3; ++k)
+            t.row({v.name, std::string(vertexWorkName(works[k])), times[k].median * 1e3,
+                   times[k].min * 1e3, times[k].max * 1e3, times[0].median / times[k].median,
+                   (long long)stats[k].vertexTransforms,
+                   double(stats[k].vertexTransforms) / double(raster.positions.size()),
+                   (long long)buffersDiffering(buffers[k], buffers[2])});
+    }
+    t.timeAndError("ms/frame", "min ms", "max ms", "pixels differing");
+    return t;
+}
+
+Table measureTexture(const MeasureSettings& m, const std::string& pngStem,
+                     std::vector<std::pair<std::string, std::string>>& images) {
+    Table t;
+    t.id = "texture";
+    t.title =
+        "Texture coordinates on a floor: perspective-correct and affine against the ray tracer";
+    t.columns = {"renderer",         "ms/frame",
+                 "min ms",           "max ms",
+                 "pixels differing", "differing % of floor",
+                 "colour differs",   "max texcoord error (texels)"};
+    t.note = std::to_string(m.width) + "x" + std::to_string(m.height) +
+             ", a 20 x 20 texel checker on a floor quad of two triangles seen at a low angle, "
+             "no shadows, one thread, median of " +
+             std::to_string(m.repeats) +
+             " frames; pixels differing: another texel than the ray tracer's (or the floor on "
+             "one side only); colour differs: a channel differs by more than 1e-3 (linear) from "
+             "the ray tracer's image; texcoord error where both see the floor";
+    TexturedFloor floor = texturedFloor(float(m.width) / float(m.height));
+    attachGrid(floor.scene);
+    const Camera& camera = floor.scene.camera;
+    RasterScene raster = texturedRasterScene(floor);
+    std::vector<glm::vec2> tracedUv;
+    Image traced =
+        traceTexturedFloor(floor.scene, floor.frame, camera, m.width, m.height, &tracedUv);
+    Timing tracedTime = measure(m.repeats, [&] {
+        keepValue(
+            traceTexturedFloor(floor.scene, floor.frame, camera, m.width, m.height).pixels()[0].x);
+    });
+    for (bool correct : {true, false}) {
+        RasterSettings rs = rasterSettings(m);
+        rs.perspectiveCorrect = correct;
+        FrameBuffers buffers;
+        Image image = rasterTexturedFloor(floor.scene, raster, camera, rs, buffers);
+        Timing time = measure(m.repeats, [&] {
+            keepValue(rasterTexturedFloor(floor.scene, raster, camera, rs, buffers).pixels()[0].x);
+        });
+        TextureComparison c = compareTexturedFloor(image, traced, raster, buffers, tracedUv);
+        t.row({std::string(correct ? "rasterizer, perspective-correct" : "rasterizer, affine"),
+               time.median * 1e3, time.min * 1e3, time.max * 1e3, (long long)c.differing,
+               100.0 * c.differingShare(), (long long)c.colourDiffering, c.maxTexcoordError});
+        if (!pngStem.empty()) {
+            std::string path = pngStem + (correct ? "-texture.png" : "-texture-affine.png");
+            image.writePng(path);
+            images.push_back({path, correct ? "the textured floor rasterized, texture coordinates "
+                                              "interpolated perspective-correct"
+                                            : "the same floor with affine texture coordinates: "
+                                              "the texels bend at the quad's diagonal"});
+        }
+    }
+    t.row({std::string("ray tracer (the reference)"), tracedTime.median * 1e3, tracedTime.min * 1e3,
+           tracedTime.max * 1e3, 0LL, 0.0, 0LL, 0.0});
+    if (!pngStem.empty()) {
+        std::string path = pngStem + "-texture-traced.png";
+        traced.writePng(path);
+        images.push_back({path, "the textured floor ray traced: the reference"});
+    }
+    t.timeAndError("ms/frame", "min ms", "max ms", "pixels differing");
+    return t;
+}
+
 void compareWithRayTracer(const StepRun& run, const RasterView& view, const RasterFrame& frame,
                           Report& report) {
     const Scene& scene = run.scene;
@@ -391,6 +525,27 @@ void compareWithRayTracer(const StepRun& run, const RasterView& view, const Rast
         rasterMs, shadeMs, traced.milliseconds);
 }
 
+void compareTextureWithRayTracer(const StepRun& run, const TexturedFloor& floor,
+                                 const RasterView& view, const RasterFrame& frame, Report& report) {
+    const int w = view.raster.width, h = view.raster.height;
+    std::vector<glm::vec2> tracedUv;
+    Image traced = traceTexturedFloor(run.scene, floor.frame, run.camera, w, h, &tracedUv);
+    std::string path = pngWithSuffix(run.png, "-traced");
+    traced.writePng(path);
+    report.images.push_back({path, "the textured floor ray traced: the reference"});
+    TextureComparison c =
+        compareTexturedFloor(frame.shaded.image, traced, view.scene, frame.buffers, tracedUv);
+    report.facts["texture"] = {{"floor_pixels", c.floorPixels},
+                               {"pixels_differing", c.differing},
+                               {"colour_differing", c.colourDiffering},
+                               {"max_texcoord_error", c.maxTexcoordError}};
+    std::printf(
+        "textured floor (%s): %zu of %zu floor pixels show another texel than the ray "
+        "tracer's (%zu differ in colour), texture coordinates off by at most %.3g texels\n",
+        view.raster.perspectiveCorrect ? "perspective-correct" : "affine", c.differing,
+        c.floorPixels, c.colourDiffering, c.maxTexcoordError);
+}
+
 void measureRaster(const StepRun& run, Report& report) {
     MeasureSettings ms;
     ms.width = run.options.width;
@@ -405,6 +560,9 @@ void measureRaster(const StepRun& run, Report& report) {
     report.add(measureShadowMethods(views[0], ms));
     std::cerr << "06_raster: interpolation...\n";
     report.add(measureInterpolation(views[0], ms, pngStem(run.png), report.images));
+    std::cerr << "06_raster: vertex work and textures...\n";
+    report.add(measureVertexPrecalc({views[0], views[1]}, ms));
+    report.add(measureTexture(ms, pngStem(run.png), report.images));
     report.plots.push_back(
         {{"table", "shadow_bias"},
          {"x", "bias (x diagonal)"},

@@ -1,7 +1,8 @@
 // Step 06's measurements: the program's frame against the ray tracer (--compare); primary
 // visibility and time per frame of the rasterizer against the ray tracer on a few views,
 // the shadow map's bias against acne and peter-panning, the two shadow methods against the
-// ray tracer's shadows, and affine against perspective-correct interpolation (--measure).
+// ray tracer's shadows, affine against perspective-correct interpolation, the vertex work
+// precalculated or not, and the textured floor against the ray tracer (--measure).
 #pragma once
 
 #include <algorithm>
@@ -60,10 +61,27 @@ Table measureInterpolation(const MeasureView& bunny, const MeasureSettings& sett
                            const std::string& pngStem,
                            std::vector<std::pair<std::string, std::string>>& images);
 
+// The lecture's "precalculate: vertex shaders": the transform to clip space done once per
+// vertex, at every triangle corner, or for every pixel; time per frame against pixels whose
+// buffers differ from the once-per-vertex frame's.
+Table measureVertexPrecalc(const std::vector<MeasureView>& views, const MeasureSettings& settings);
+
+// The textured floor (texture.hpp): the rasterizer perspective-correct and affine against
+// the ray tracer, pixels differing and time per frame; writes the three images next to
+// `pngStem` when it is not empty.
+Table measureTexture(const MeasureSettings& settings, const std::string& pngStem,
+                     std::vector<std::pair<std::string, std::string>>& images);
+
 // The program's --compare: the frame's ids, depths and shadows against the ray tracer's of
 // the same view (a "compare" fact, the difference image FILE-diff.png, lines on stdout).
 void compareWithRayTracer(const StepRun& run, const RasterView& view, const RasterFrame& frame,
                           Report& report);
+
+// The program's --compare with --floor-texture: the ray tracer's textured floor of the
+// same view (FILE-traced.png), the pixels that differ, a "texture" fact, a line on stdout.
+struct TexturedFloor;
+void compareTextureWithRayTracer(const StepRun& run, const TexturedFloor& floor,
+                                 const RasterView& view, const RasterFrame& frame, Report& report);
 
 // The program's --measure: every table above at the image's size, with the bias plot.
 void measureRaster(const StepRun& run, Report& report);

@@ -151,6 +151,36 @@ FrameStats rasterizeFrame(const RasterScene& scene, const Camera& camera,
     auto band = guardBandPlanes(settings.guardBand);
     std::copy(band.begin(), band.end(), planes.begin() + 2);
 
+    // The vertex shader's work for one vertex: model (here world) space to clip space.
+    auto transform = [&](uint32_t vertex) {
+        ++stats.vertexTransforms;
+        return viewProjection * Vec4d(glm::dvec3(scene.positions[vertex]), 1.0);
+    };
+    const VertexWork work = settings.vertexWork;
+    if (work == VertexWork::OncePerVertex) {
+        buffers.clipPositions.resize(scene.positions.size());
+        for (size_t k = 0; k < scene.positions.size(); ++k)
+            buffers.clipPositions[k] = transform(uint32_t(k));
+    }
+    // What a fan triangle's pixels need of its corners: their unsnapped screen positions,
+    // their w and its reciprocal, and the doubled area.
+    struct Corners {
+        glm::dvec2 exact[3];
+        glm::dvec3 w, inverseW;
+        double area = 0.0;
+        bool useExact = false;
+    };
+    auto cross = [](glm::dvec2 a, glm::dvec2 b) { return a.x * b.y - a.y * b.x; };
+    auto setUp = [&](const Vec4d* clip[3], Corners& c) {
+        for (int i = 0; i < 3; ++i) {
+            c.exact[i] = glm::dvec2(clipToScreen(*clip[i], width, height));
+            c.w[i] = clip[i]->w;
+        }
+        c.inverseW = 1.0 / c.w;
+        c.area = cross(c.exact[1] - c.exact[0], c.exact[2] - c.exact[0]);
+        c.useExact = std::abs(c.area) > 1e-9;
+    };
+
     auto draw = [&](size_t t) {
         ++stats.trianglesIn;
         const auto& tri = scene.triangles[t];
@@ -158,7 +188,8 @@ FrameStats rasterizeFrame(const RasterScene& scene, const Camera& camera,
         for (int k = 0; k < 3; ++k) {
             glm::dvec3 weights(0.0);
             weights[k] = 1.0;
-            polygon.add({viewProjection * Vec4d(glm::dvec3(scene.positions[tri[size_t(k)]]), 1.0),
+            polygon.add({work == VertexWork::OncePerVertex ? buffers.clipPositions[tri[size_t(k)]]
+                                                           : transform(tri[size_t(k)]),
                          weights});
         }
         // Trivially outside one plane: nothing to draw. Inside every plane: no clipping.
@@ -185,43 +216,49 @@ FrameStats rasterizeFrame(const RasterScene& scene, const Camera& camera,
                 return;
             }
         }
+        // Per pixel, an unclipped triangle's corners are transformed again for every pixel
+        // (a clipped one keeps the clipper's new vertices).
+        const bool perPixel = work == VertexWork::PerPixel && inside;
         // The convex polygon as a fan; every piece keeps the triangle's winding.
         bool drawn = false;
         for (int k = 1; k + 1 < polygon.count; ++k) {
             const ClipVertex* v[3] = {&polygon.vertices[0], &polygon.vertices[size_t(k)],
                                       &polygon.vertices[size_t(k + 1)]};
+            const Vec4d* clip[3] = {&v[0]->position, &v[1]->position, &v[2]->position};
+            Corners corners;
+            setUp(clip, corners);
             FixedPoint2 s[3];
-            glm::dvec2 exact[3];
-            glm::dvec3 w;
-            for (int i = 0; i < 3; ++i) {
-                glm::dvec3 p = clipToScreen(v[i]->position, width, height);
-                exact[i] = glm::dvec2(p);
-                s[i] = snapToSubpixel(p.x, p.y);
-                w[i] = v[i]->position.w;
-            }
-            const glm::dvec3 inverseW = 1.0 / w;
+            for (int i = 0; i < 3; ++i)
+                s[i] = snapToSubpixel(corners.exact[i].x, corners.exact[i].y);
             // Coverage comes from the snapped (exact integer) edge functions; the weights
             // for depth and attributes from the unsnapped positions, so snapping moves
             // edges by at most 1/512 pixel but never tilts the interpolated plane.
-            auto cross = [](glm::dvec2 a, glm::dvec2 b) { return a.x * b.y - a.y * b.x; };
-            const double exactArea = cross(exact[1] - exact[0], exact[2] - exact[0]);
-            const bool useExact = std::abs(exactArea) > 1e-9;
             int64_t area = rasterizeTriangle(
                 s[0], s[1], s[2], width, height, settings.backfaceCulling,
                 [&](int x, int y, glm::dvec3 screen) {
                     ++stats.fragments;
-                    if (useExact) {
-                        glm::dvec2 p(double(x) + 0.5, double(y) + 0.5);
-                        screen = glm::dvec3(cross(exact[2] - exact[1], p - exact[1]),
-                                            cross(exact[0] - exact[2], p - exact[2]),
-                                            cross(exact[1] - exact[0], p - exact[0])) /
-                                 exactArea;
+                    Corners again;
+                    const Corners* c = &corners;
+                    if (perPixel) {
+                        Vec4d p[3] = {transform(tri[0]), transform(tri[1]), transform(tri[2])};
+                        const Vec4d* q[3] = {&p[0], &p[1], &p[2]};
+                        setUp(q, again);
+                        c = &again;
                     }
-                    double depth = 1.0 / glm::dot(screen, inverseW);
+                    if (c->useExact) {
+                        glm::dvec2 p(double(x) + 0.5, double(y) + 0.5);
+                        const glm::dvec2* e = c->exact;
+                        screen =
+                            glm::dvec3(cross(e[2] - e[1], p - e[1]), cross(e[0] - e[2], p - e[2]),
+                                       cross(e[1] - e[0], p - e[0])) /
+                            c->area;
+                    }
+                    double depth = 1.0 / glm::dot(screen, c->inverseW);
                     size_t i = buffers.index(x, y);
                     if (!depthTest(buffers.depth[i], float(depth)) || settings.depthOnly) return;
-                    glm::dvec3 l =
-                        settings.perspectiveCorrect ? perspectiveCorrectWeights(screen, w) : screen;
+                    glm::dvec3 l = settings.perspectiveCorrect
+                                       ? perspectiveCorrectWeights(screen, c->w)
+                                       : screen;
                     glm::dvec3 original =
                         l.x * v[0]->weights + l.y * v[1]->weights + l.z * v[2]->weights;
                     buffers.triangle[i] = uint32_t(t);
@@ -298,6 +335,18 @@ bool litByShadowRay(const Scene& scene, const Vec3& point, const Vec3& geometric
     // END SOLUTION
 }
 
+const char* vertexWorkName(VertexWork work) {
+    switch (work) {
+        case VertexWork::OncePerVertex:
+            return "once per vertex (vertex shader)";
+        case VertexWork::PerCorner:
+            return "per triangle corner";
+        case VertexWork::PerPixel:
+            return "per pixel";
+    }
+    return "?";
+}
+
 const char* shadowModeName(ShadowMode mode) {
     switch (mode) {
         case ShadowMode::None:
@@ -322,6 +371,22 @@ bool surfaceAt(const RasterScene& scene, const FrameBuffers& buffers, int x, int
     hit.object = scene.object[id];
     hit.primitive = id;
     return true;
+}
+
+bool texcoordAt(const RasterScene& scene, const FrameBuffers& buffers, int x, int y, Vec2& uv) {
+    size_t i = buffers.index(x, y);
+    uint32_t id = buffers.triangle[i];
+    if (id == kNoPrimitive || scene.texcoords.empty()) return false;
+    const auto& tri = scene.triangles[id];
+    const float w1 = buffers.weight1[i], w2 = buffers.weight2[i];
+    uv = (1.0f - w1 - w2) * scene.texcoords[tri[0]] + w1 * scene.texcoords[tri[1]] +
+         w2 * scene.texcoords[tri[2]];
+    return true;
+}
+
+float checkerTexel(Vec2 uv, float dark) {
+    glm::ivec2 cell = glm::ivec2(glm::floor(uv));
+    return ((cell.x + cell.y) & 1) ? dark : 1.0f;
 }
 
 ShadedFrame shadeFrame(const Scene& scene, const RasterScene& raster, const Camera& camera,
@@ -355,6 +420,9 @@ ShadedFrame shadeFrame(const Scene& scene, const RasterScene& raster, const Came
                 glm::ivec3 cell = glm::ivec3(glm::floor(hit.point / checkerSize));
                 if ((cell.x + cell.y + cell.z) & 1) m.albedo *= 0.3f;
             }
+            Vec2 uv;
+            if (settings.texture && texcoordAt(raster, buffers, x, y, uv))
+                m.albedo *= checkerTexel(uv);
             Vec3 colour = scene.ambient * m.albedo;
             for (size_t l = 0; l < scene.lights.size(); ++l) {
                 const PointLight& light = scene.lights[l];

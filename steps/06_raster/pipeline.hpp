@@ -23,7 +23,10 @@ struct RasterScene {
     std::vector<std::array<uint32_t, 3>> triangles;
     std::vector<int> material;  // per triangle
     std::vector<int> object;    // per triangle: the scene object, numbered as the ray tracer does
-    size_t meshTriangles = 0;   // triangles [0, meshTriangles) are the mesh's, in file order
+    // Per vertex, texture coordinates (the vertex in its surface's tangent space, in texels);
+    // empty when the scene has none.
+    std::vector<Vec2> texcoords;
+    size_t meshTriangles = 0;  // triangles [0, meshTriangles) are the mesh's, in file order
     Vec3 boundsMin{0.0f}, boundsMax{0.0f};  // of everything but the planes
     bool hasPlanes = false;
 
@@ -32,6 +35,13 @@ struct RasterScene {
     float diagonal() const { return glm::length(boundsMax - boundsMin); }
 };
 
+// Where the per-vertex work (the transform to clip space, and for the pixels' weights the
+// divide by w and the viewport) is done: once per vertex before any triangle, as a vertex
+// shader does (the lecture's "precalculate"); again at every corner of every triangle that
+// uses the vertex; or again for every pixel a triangle covers. All three give the same bits.
+enum class VertexWork { OncePerVertex, PerCorner, PerPixel };
+const char* vertexWorkName(VertexWork work);
+
 struct RasterSettings {
     int width = 640, height = 480;
     double near = 0.0, far = 0.0;  // 0: chosen from the scene's bounds (see nearFarFor)
@@ -39,6 +49,7 @@ struct RasterSettings {
     bool perspectiveCorrect = true;  // false: affine weights (textures and normals warp)
     double guardBand = 64.0;         // clip |x|, |y| <= guardBand * w
     bool depthOnly = false;          // only the depth buffer (a shadow map)
+    VertexWork vertexWork = VertexWork::OncePerVertex;
 };
 
 // Near and far planes for a view: the settings' own when given (checked: 0 < near < far),
@@ -54,18 +65,20 @@ struct FrameBuffers {
     std::vector<uint32_t> triangle;  // kNoPrimitive where nothing is drawn
     std::vector<float> depth;        // +infinity where nothing is drawn
     std::vector<float> weight1, weight2;
+    std::vector<Vec4d> clipPositions;  // per vertex, when the vertex work is done once
     void reset(int w, int h, bool depthOnly = false);
     size_t index(int x, int y) const { return size_t(y) * size_t(width) + size_t(x); }
 };
 
 struct FrameStats {
-    size_t trianglesIn = 0;     // offered to the pipeline
-    size_t trianglesDrawn = 0;  // that reached the rasterizer with some area
-    size_t culledOutside = 0;   // entirely outside a clip plane (behind the eye, beyond far, ...)
-    size_t culledBackface = 0;  // back faces (when culling is on) and zero-area triangles
-    size_t clipped = 0;         // cut by a plane into a smaller polygon
-    size_t fragments = 0;       // pixel centres covered (before the depth test)
-    size_t pixelsCovered = 0;   // pixels with a triangle after the frame
+    size_t trianglesIn = 0;       // offered to the pipeline
+    size_t trianglesDrawn = 0;    // that reached the rasterizer with some area
+    size_t culledOutside = 0;     // entirely outside a clip plane (behind the eye, beyond far, ...)
+    size_t culledBackface = 0;    // back faces (when culling is on) and zero-area triangles
+    size_t clipped = 0;           // cut by a plane into a smaller polygon
+    size_t fragments = 0;         // pixel centres covered (before the depth test)
+    size_t pixelsCovered = 0;     // pixels with a triangle after the frame
+    size_t vertexTransforms = 0;  // vertices taken to clip space (see VertexWork)
     double milliseconds = 0.0;
 };
 
@@ -104,6 +117,9 @@ struct ShadeSettings {
     double mapBias = 0.0;  // world units; 0: 2e-3 of the scene's diagonal
     int mapSize = 2048;
     bool checker = false;  // modulate the albedo with a checker on the interpolated position
+    // Modulate the albedo with a checker of texels from the interpolated texture
+    // coordinates (where the scene has them).
+    bool texture = false;
 };
 
 // What the shading pass found per pixel, for comparisons with the ray tracer.
@@ -118,6 +134,14 @@ struct ShadedFrame {
 // with the stored weights).
 bool surfaceAt(const RasterScene& scene, const FrameBuffers& buffers, int x, int y,
                SurfaceHit& hit);
+
+// The texture coordinates at a pixel: the vertices' interpolated with the stored weights
+// (perspective-correct unless the frame was drawn affine); false where no triangle is seen
+// or the scene has no texture coordinates.
+bool texcoordAt(const RasterScene& scene, const FrameBuffers& buffers, int x, int y, Vec2& uv);
+
+// The procedural texture: a checker of unit texels, 1 on even cells and `dark` on odd ones.
+float checkerTexel(Vec2 uv, float dark = 0.3f);
 
 ShadedFrame shadeFrame(const Scene& scene, const RasterScene& raster, const Camera& camera,
                        const FrameBuffers& buffers, const ShadeSettings& settings,

@@ -59,7 +59,9 @@ Image RasterViewer::render(const Camera& camera) {
     if (shown_ == Shown::Raster) return std::move(frame.shaded.image);
     if (shown_ == Shown::Traced) {
         Stopwatch watch;
-        Image image = renderImage(scene_, camera, traced_);
+        Image image = textureFrame ? traceTexturedFloor(scene_, *textureFrame, camera,
+                                                        view_.raster.width, view_.raster.height)
+                                   : renderImage(scene_, camera, traced_);
         tracedMs_ = watch.milliseconds();
         return image;
     }

@@ -7,6 +7,7 @@
 
 #include "06_raster/compare.hpp"
 #include "06_raster/frame.hpp"
+#include "06_raster/texture.hpp"
 #include "core/render.hpp"
 #include "core/window.hpp"
 
@@ -21,6 +22,8 @@ public:
     bool onKey(int key);  // true when the key was used
     Image render(const Camera& camera);
     void panel() const;
+    // With the textured floor: the ray tracer's view is its textured image (texture.hpp).
+    const TangentFrame* textureFrame = nullptr;
 
 private:
     enum class Shown { Raster, Traced, Difference };

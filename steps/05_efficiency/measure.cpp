@@ -51,6 +51,8 @@ void measureLab(const Scene& scene, LabBvhMesh* mesh, const LabOptions& o, Repor
     step("precalculation", [&] { return measurePrecalculation(*mesh, o); });
     step("expensive operations", [&] { return measureExpensiveOps(o); });
     step("reciprocal square root", [&] { return measureInverseSqrt(o); });
+    step("the cost of one operation", [&] { return measureOpCost(o); });
+    step("compiler flags, float and double", [&] { return measureLanguage(o); });
     step("threads", [&] { return measureThreads(scene, o); });
     step("anti-aliasing", [&] { return measureAntiAliasing(scene, o); });
     step("previews", [&] { return measurePreviews(scene, o); });

@@ -22,6 +22,9 @@ BOXES_LANGUAGE_KERNEL_DECLARATIONS
 namespace o2 {
 BOXES_LANGUAGE_KERNEL_DECLARATIONS
 }
+namespace o3 {
+BOXES_LANGUAGE_KERNEL_DECLARATIONS
+}
 #if BOXES_LANGUAGE_NATIVE
 namespace native {
 BOXES_LANGUAGE_KERNEL_DECLARATIONS
@@ -36,6 +39,7 @@ const std::vector<KernelVariant>& kernelVariants() {
         {"O0", o0::flags(), o0::nearestFloat, o0::nearestDouble},
         {"O1", o1::flags(), o1::nearestFloat, o1::nearestDouble},
         {"O2", o2::flags(), o2::nearestFloat, o2::nearestDouble},
+        {"O3", o3::flags(), o3::nearestFloat, o3::nearestDouble},
 #if BOXES_LANGUAGE_NATIVE
         {"native", native::flags(), native::nearestFloat, native::nearestDouble},
         {"native+fma", native_fma::flags(), native_fma::nearestFloat, native_fma::nearestDouble},
@@ -77,7 +81,7 @@ Table measureLanguage(const LabOptions& o) {
     for (int i = 0; i < 32; ++i)
         for (double v : {4.0 * u(rng), 3.0 * u(rng), -2.0 + u(rng), 0.3 + 0.2 * std::abs(u(rng))})
             spheres.push_back(v);
-    const size_t n = size_t(samples(o, 16384));
+    const size_t n = size_t(samples(o, 4096));
     for (size_t i = 0; i < n; ++i) {
         // Towards a point of the plane z = -2, through the middle of the field.
         double x = 5.0 * u(rng), y = 3.5 * u(rng), z = -2.0 - 8.0;

@@ -3,6 +3,7 @@
 // operation's latency and the compiler can neither fold nor vectorize it.
 #include <algorithm>
 #include <cmath>
+#include <stdexcept>
 
 #include "05_efficiency/experiments/lab_helpers.hpp"
 #include "05_efficiency/measure.hpp"
@@ -38,7 +39,7 @@ OpCost chainCost(const LabOptions& o, const char* op, const char* type, T start,
         worst = std::max(worst, double(std::abs((long double)y - e) / std::abs(e)));
         x = y;
     }
-    const long long steps = o.quick ? 2000 : 50000;
+    const long long steps = o.quick ? 2000 : 200000;
     Timing tm = measure(o.repeats, [&] {
         T v = opaque(start), k = opaque(c);
         for (long long i = 0; i < steps; ++i) v = step(v, k);
@@ -97,13 +98,18 @@ Table measureOpCost(const LabOptions& o) {
         "error: the largest relative error of one operation on the chain's inputs against the "
         "same operation in long double on the same input";
     std::vector<OpCost> costs = measureOpCosts(o);
-    for (const OpCost& c : costs) {
-        double add = 0.0;
-        for (const OpCost& a : costs)
-            if (a.op == "+" && a.type == c.type) add = a.nsMedian;
-        t.row({c.op, c.type, c.nsMedian, c.nsMin, c.nsMax, add > 0.0 ? c.nsMedian / add : 0.0,
-               c.relError});
-    }
+    auto find = [&](const std::string& op, const std::string& type) {
+        for (const OpCost& c : costs)
+            if (c.op == op && c.type == type) return c;
+        throw std::logic_error("op_cost: no " + op + " " + type);
+    };
+    // Float and double of one operation next to each other, in the primer's order.
+    for (const char* op : {"sin", "cos", "sqrt", "/", "*", "+", "-"})
+        for (const char* type : {"float", "double"}) {
+            OpCost c = find(op, type);
+            t.row({c.op, c.type, c.nsMedian, c.nsMin, c.nsMax, c.nsMedian / find("+", type).nsMedian,
+                   c.relError});
+        }
     t.timeAndError("ns/op", "min ns", "max ns", "max rel error");
     return t;
 }

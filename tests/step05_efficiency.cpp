@@ -908,7 +908,8 @@ TEST_SUITE("lab 05") {
             // Rays within 0.5 of the axis hit the far sphere too: the near hit is the answer.
             exact.push_back(r <= 1.0 ? 5.0 - std::sqrt(1.0 - r * r) : INFINITY);
         }
-        std::vector<float> spheresF(spheres.begin(), spheres.end()), raysF(rays.begin(), rays.end());
+        std::vector<float> spheresF(spheres.begin(), spheres.end()),
+            raysF(rays.begin(), rays.end());
         for (const auto& v : variants) {
             INFO(v.name << " (" << v.flags << ")");
             CHECK(v.flags.find("-ffast-math") == std::string::npos);
@@ -928,8 +929,9 @@ TEST_SUITE("lab 05") {
             }
         }
     }
-    TEST_CASE("language table: every variant in float and double and the double O2 row is the "
-              "reference") {
+    TEST_CASE(
+        "language table: every variant in float and double and the double O2 row is the "
+        "reference") {
         LabOptions o;
         o.quick = true;
         o.repeats = 1;
@@ -1018,10 +1020,11 @@ TEST_SUITE("program 05") {
             {"measuring", "float_double", "acne", "sincos", "early_out", "light_radius", "effects",
              "precalc", "expensive_ops", "rsqrt", "op_cost", "language", "threads", "antialiasing",
              "previews", "total", "effects_parts", "effects_identity"});
-        test::checkVariantTables(dir.file("r.json"),
-                                 {"float_double", "acne", "sincos", "early_out", "light_radius",
-                                  "effects", "effects_parts", "precalc", "expensive_ops", "rsqrt",
-                                  "op_cost", "language", "threads", "antialiasing", "previews", "total"});
+        test::checkVariantTables(
+            dir.file("r.json"),
+            {"float_double", "acne", "sincos", "early_out", "light_radius", "effects",
+             "effects_parts", "precalc", "expensive_ops", "rsqrt", "op_cost", "language", "threads",
+             "antialiasing", "previews", "total"});
         CHECK(run.out.find("table nearest 3600") != std::string::npos);
     }
     TEST_CASE("window: previews and refinement under the offscreen video driver") {

@@ -30,11 +30,11 @@ const std::vector<KernelVariant>& kernelVariants();
 const KernelVariant& referenceVariant();
 
 // What each copy of the kernel defines, in namespace boxes::language::NAME.
-#define BOXES_LANGUAGE_KERNEL_DECLARATIONS                                                      \
-    const char* flags();                                                                        \
-    void nearestFloat(const float* spheres, size_t sphereCount, const float* rays,              \
-                      size_t rayCount, float* t);                                               \
-    void nearestDouble(const double* spheres, size_t sphereCount, const double* rays,           \
+#define BOXES_LANGUAGE_KERNEL_DECLARATIONS                                            \
+    const char* flags();                                                              \
+    void nearestFloat(const float* spheres, size_t sphereCount, const float* rays,    \
+                      size_t rayCount, float* t);                                     \
+    void nearestDouble(const double* spheres, size_t sphereCount, const double* rays, \
                        size_t rayCount, double* t);
 
 }  // namespace boxes::language

@@ -64,8 +64,8 @@ void nearestFloat(const float* spheres, size_t sphereCount, const float* rays, s
                   float* t) {
     nearest(spheres, sphereCount, rays, rayCount, t);
 }
-void nearestDouble(const double* spheres, size_t sphereCount, const double* rays,
-                   size_t rayCount, double* t) {
+void nearestDouble(const double* spheres, size_t sphereCount, const double* rays, size_t rayCount,
+                   double* t) {
     nearest(spheres, sphereCount, rays, rayCount, t);
 }
 

@@ -107,8 +107,8 @@ Table measureOpCost(const LabOptions& o) {
     for (const char* op : {"sin", "cos", "sqrt", "/", "*", "+", "-"})
         for (const char* type : {"float", "double"}) {
             OpCost c = find(op, type);
-            t.row({c.op, c.type, c.nsMedian, c.nsMin, c.nsMax, c.nsMedian / find("+", type).nsMedian,
-                   c.relError});
+            t.row({c.op, c.type, c.nsMedian, c.nsMin, c.nsMax,
+                   c.nsMedian / find("+", type).nsMedian, c.relError});
         }
     t.timeAndError("ns/op", "min ns", "max ns", "max rel error");
     return t;

@@ -51,6 +51,8 @@ void measureLab(const Scene& scene, LabBvhMesh* mesh, const LabOptions& o, Repor
     step("precalculation", [&] { return measurePrecalculation(*mesh, o); });
     step("expensive operations", [&] { return measureExpensiveOps(o); });
     step("reciprocal square root", [&] { return measureInverseSqrt(o); });
+    step("the cost of one operation", [&] { return measureOpCost(o); });
+    step("compiler flags, float and double", [&] { return measureLanguage(o); });
     step("threads", [&] { return measureThreads(scene, o); });
     step("anti-aliasing", [&] { return measureAntiAliasing(scene, o); });
     step("previews", [&] { return measurePreviews(scene, o); });
@@ -83,6 +85,14 @@ void measureLab(const Scene& scene, LabBvhMesh* mesh, const LabOptions& o, Repor
          "Float against double: time per test against the error in t", false, true);
     plot("sincos", "ns/call", "max abs error", "variant",
          "Sine: time per call against the largest error over the circle", false, true);
+    plot("op_cost", "ns/op", "max rel error", "type",
+         "The cost of one operation: ns per operation against its relative error, float and "
+         "double",
+         true, true);
+    plot("language", "ns/ray", "max rel t error", "type",
+         "One kernel under different compiler flags: time per ray against the error in t "
+         "(against double -O2; 0: the same bits)",
+         true, false);
     plot("antialiasing", "ms/frame", "RMSE", "",
          "Anti-aliasing: error against time for 1, 4, 16, 64 samples per pixel", true, true, true);
     plot("threads", "threads", "speed-up", "schedule", "Threads: speed-up over one thread", false,

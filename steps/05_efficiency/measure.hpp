@@ -42,6 +42,18 @@ const std::vector<std::string>& effectsSceneNames();
 Table measurePrecalculation(LabBvhMesh& mesh, const LabOptions& o);
 Table measureExpensiveOps(const LabOptions& o);  // sqrt and division per ray
 Table measureInverseSqrt(const LabOptions& o);
+// The cost of one operation (the primer's list: sin, cos, sqrt, /, *, +, -) in float and
+// double: ns per operation in a dependent chain, and the largest relative error of one
+// operation against long double.
+struct OpCost {
+    std::string op, type;  // "sqrt", "float"
+    double nsMedian, nsMin, nsMax;
+    double relError;
+};
+std::vector<OpCost> measureOpCosts(const LabOptions& o);
+Table measureOpCost(const LabOptions& o);
+// The choice of language: one kernel under different compiler flags (language.hpp).
+Table measureLanguage(const LabOptions& o);
 Table measureThreads(const Scene& scene, const LabOptions& o);
 Table measureAntiAliasing(const Scene& scene, const LabOptions& o);
 Table measurePreviews(const Scene& scene, const LabOptions& o);

@@ -727,6 +727,9 @@ TEST_SUITE("program 06") {
         test::runHeadless(program, dir, 48, 36, "--measure --report r.json");
         test::checkReportTables(dir.file("r.json"), {"visibility", "frame_time", "shadow_bias",
                                                      "shadows", "interpolation", "culling"});
+        test::checkVariantTables(dir.file("r.json"),
+                                 {"shadow_bias", "shadows", "interpolation", "culling"});
+        test::checkParetoPlot(dir.file("r.json"), "shadows");
         CHECK(test::pngSize(dir.file("a-affine.png")) == std::pair{48, 36});
     }
     TEST_CASE("window: scripted frames with key presses under the offscreen video driver") {

@@ -299,9 +299,8 @@ void measureTriangleTests(const StepRun& run, const TriangleGrid& grid, size_t c
                             {"logy", true},
                             {"pareto", true},
                             {"title",
-                             "Accuracy against time: cracks per million rays aimed at shared "
-                             "edges and vertices; the Pareto front joins the tests no other "
-                             "beats on both"}});
+                             "Triangle tests: cracks per million crack rays against time per "
+                             "test, with the Pareto front"}});
 }
 
 }  // namespace boxes

@@ -285,8 +285,8 @@ void measureBoxTests(const StepRun& run, BoxSet& set, size_t raysPerBox, Report&
          {"logy", true},
          {"pareto", true},
          {"title",
-          "Six planes against slabs: time per test and wrong hit/miss answers; the Pareto front "
-          "joins the variants no other beats on both"}});
+          "Six planes against slabs: wrong hit/miss answers against time per test, with the "
+          "Pareto front"}});
     report.plots.push_back(
         {{"table", "box_accuracy"},
          {"x", "ns/test"},

@@ -165,7 +165,8 @@ PretestResult measurePretest(ManyObjects& objects, const Camera& camera,
                     int y = set + kSets * i;
                     renderer.renderRows(image, y, y + 1, perThread[size_t(thread)]);
                 },
-                s.progressLabel);
+                s.progressLabel + ", row set " + std::to_string(set + 1) + " of " +
+                    std::to_string(kSets));
             setMs.push_back(watch.milliseconds() * double(s.height) / double(rows));
         }
         Timing ms = summarize(setMs);
@@ -217,8 +218,8 @@ void measureBoundingBoxes(const StepRun& run, ManyObjects& objects, size_t hardR
                             {"logy", true},
                             {"pareto", true},
                             {"title",
-                             "Slab tests: time per test and wrong answers on hard rays; the "
-                             "Pareto front joins the tests no other beats on both"}});
+                             "Slab tests: wrong answers on hard rays against time per test, "
+                             "with the Pareto front"}});
     report.plots.push_back(
         {{"table", "pretest"},
          {"x", "ms/frame"},

@@ -565,6 +565,8 @@ TEST_SUITE("program 01") {
         auto run = test::runHeadless(program, dir, 32, 24,
                                      "--scene sh1 --measure --crack-rays 2000 --report r.json");
         test::checkReportTables(dir.file("r.json"), {"triangle_speed", "cracks"});
+        test::checkVariantTables(dir.file("r.json"), {"triangle_speed", "accuracy_vs_time"});
+        test::checkParetoPlot(dir.file("r.json"), "accuracy_vs_time");
         CHECK(test::pngSize(dir.file("a-disagree.png")) == std::pair{32, 24});
         CHECK(run.out.find("watertight float") != std::string::npos);
     }

@@ -461,6 +461,8 @@ TEST_SUITE("program 02") {
             test::runHeadless(program, dir, 32, 24, "--measure --rays-per-box 20 --report r.json");
         test::checkReportTables(dir.file("r.json"),
                                 {"box_speed", "box_accuracy", "method_disagreement"});
+        test::checkVariantTables(dir.file("r.json"), {"box_speed", "box_accuracy"});
+        test::checkParetoPlot(dir.file("r.json"), "box_accuracy");
         CHECK(test::pngSize(dir.file("a-disagree.png")) == std::pair{32, 24});
         CHECK(run.out.find("six planes") != std::string::npos);
     }

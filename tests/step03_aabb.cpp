@@ -530,6 +530,8 @@ TEST_SUITE("program 03") {
                                      "--measure --hard-rays 50 --measure-width 12 "
                                      "--measure-height 8 --scene spheres --report r.json");
         test::checkReportTables(dir.file("r.json"), {"slab_accuracy", "slab_hard_rays", "pretest"});
+        test::checkVariantTables(dir.file("r.json"), {"slab_accuracy", "pretest"});
+        test::checkParetoPlot(dir.file("r.json"), "slab_accuracy");
         CHECK(test::readText(dir.file("r.json")).find("\"pretest_pixels_differing\": 0") !=
               std::string::npos);
         CHECK(run.out.find("conservative (3.7)") != std::string::npos);

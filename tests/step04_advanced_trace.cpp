@@ -188,6 +188,9 @@ TEST_SUITE("program 04") {
             "--scene sh1 --measure --measure-rays 400 --crack-rays 100 --report r.json");
         test::checkReportTables(dir.file("r.json"), {"bvh_build", "bvh_trace", "bvh_threads",
                                                      "bvh_cracks", "bvh_culling", "bvh_tradeoff"});
+        test::checkVariantTables(dir.file("r.json"), {"bvh_build", "bvh_trace", "bvh_cracks",
+                                                      "bvh_culling", "bvh_tradeoff"});
+        test::checkParetoPlot(dir.file("r.json"), "bvh_tradeoff");
     }
     TEST_CASE("trace command: hits equal brute force and the JSON line") {
         test::TempDir dir;

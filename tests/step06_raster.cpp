@@ -728,7 +728,9 @@ TEST_SUITE("program 06") {
         test::checkReportTables(dir.file("r.json"),
                                 {"visibility", "frame_time", "shadow_bias", "shadows",
                                  "interpolation", "culling", "vertex_precalc", "texture"});
-        test::checkVariantTables(dir.file("r.json"), {"vertex_precalc", "texture"});
+        test::checkVariantTables(dir.file("r.json"), {"shadow_bias", "shadows", "interpolation",
+                                                      "culling", "vertex_precalc", "texture"});
+        test::checkParetoPlot(dir.file("r.json"), "shadows");
         CHECK(test::pngSize(dir.file("a-affine.png")) == std::pair{48, 36});
         for (const char* png : {"a-texture.png", "a-texture-affine.png", "a-texture-traced.png"})
             CHECK(test::pngSize(dir.file(png)) == std::pair{48, 36});

@@ -163,6 +163,23 @@ inline void checkVariantTables(const std::string& path, std::initializer_list<co
     }
 }
 
+// The step's picture in a JSON report: a plot with "pareto": true of a table of variants,
+// its time column on x and its error column on y, as the report and the deck draw it.
+inline void checkParetoPlot(const std::string& path, const std::string& tableId) {
+    nlohmann::json report = nlohmann::json::parse(readText(path));
+    const nlohmann::json* table = nullptr;
+    for (const auto& t : report["tables"])
+        if (t["id"] == tableId) table = &t;
+    REQUIRE(table != nullptr);
+    REQUIRE(table->contains("time"));
+    REQUIRE(table->contains("error"));
+    bool found = false;
+    for (const auto& p : report["plots"])
+        found = found || (p.value("pareto", false) && p["table"] == tableId &&
+                          p["x"] == (*table)["time"]["median"] && p["y"] == (*table)["error"]);
+    CHECK(found);
+}
+
 // `program args --frames N --keys K --screenshot shot.png` under the offscreen video
 // driver: exits 0 and saves a non-empty screenshot of the last frame.
 inline ProgramRun runWindowScript(const std::string& program, const TempDir& dir,

@@ -161,6 +161,10 @@ def plot(report, spec, out, name):
                     mfc="none", mec="#999", label="never worth it (another is better on both)")
     scale("x", [p[0] for p in points], spec.get("logx"))
     scale("y", [p[1] for p in points], spec.get("logy"))
+    if points and not spec.get("logy") and all(p[1] == 0 for p in points):
+        # Every variant exact: the points sit on the zero line at the bottom (the default
+        # range, -0.06 to 0.06, showed errors below zero that no count can have).
+        ax.set_ylim(-0.05, 1.0)
     ax.set_xlabel(spec["x"])
     ax.set_ylabel(spec["y"])
     ax.set_title(spec.get("title", table["title"]), fontsize=10, wrap=True)

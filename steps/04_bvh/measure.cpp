@@ -19,10 +19,17 @@ BvhBuildOptions optionsFor(BvhBuilder builder, int bins) {
     return o;
 }
 
-double traceMrays(const Bvh& bvh, const std::vector<Ray>& rays, int repeats, int threads) {
+// Seconds per ray (median, min, max of the repeats).
+Timing traceTiming(const Bvh& bvh, const std::vector<Ray>& rays, int repeats, int threads) {
     std::vector<TraceHit> hits;
     Timing t = measure(repeats, [&] { traceBatch(bvh, rays, hits, threads); });
-    return double(rays.size()) / t.median / 1e6;
+    double n = double(std::max<size_t>(1, rays.size()));
+    t.median /= n, t.min /= n, t.max /= n;
+    return t;
+}
+
+double traceMrays(const Bvh& bvh, const std::vector<Ray>& rays, int repeats, int threads) {
+    return 1e-6 / traceTiming(bvh, rays, repeats, threads).median;
 }
 
 // The machine's own parallelism at the moment: a loop that touches no memory, run once per
@@ -49,13 +56,17 @@ Table measureBuilds(const NamedMesh& mesh, int bins, int repeats) {
     t.id = "bvh_build";
     t.title = "Builders on '" + mesh.name + "' (" + std::to_string(mesh.mesh->triangleCount()) +
               " triangles): build time and tree quality";
-    t.columns = {"builder",   "build ms", "ms/Mtri", "nodes",    "leaves",    "leaf min",
-                 "leaf mean", "leaf max", "depth",   "SAH cost", "vs sweep %"};
+    t.columns = {"builder",    "build ms",  "ms/Mtri",  "nodes", "leaves",
+                 "leaf min",   "leaf mean", "leaf max", "depth", "SAH cost",
+                 "vs sweep %", "min ms",    "max ms"};
     t.note = "median of " + std::to_string(repeats) +
              " builds, one thread; SAH cost with "
              "C_trav = C_isect = 1 relative to the root's area; 'vs sweep' is the excess over "
              "the full-sweep SAH tree (every centroid a candidate plane); binned SAH with " +
-             std::to_string(bins) + " bins";
+             std::to_string(bins) +
+             " bins (the sweep and the spatial splits: one build, so no spread); the error: the "
+             "SAH cost's excess over the full-sweep tree's";
+    t.timeAndError("build ms", "min ms", "max ms", "vs sweep %");
     BvhBuildStats sweep;
     buildEngineBvh(*mesh.mesh, optionsFor(BvhBuilder::SweepSah, bins), &sweep);
     for (BvhBuilder builder : {BvhBuilder::Midpoint, BvhBuilder::Median, BvhBuilder::BinnedSah,
@@ -67,12 +78,13 @@ Table measureBuilds(const NamedMesh& mesh, int bins, int repeats) {
             buildEngineBvh(*mesh.mesh, optionsFor(builder, bins), &s);
             ms.push_back(s.buildMs);
         }
-        double median = summarize(ms).median;
+        Timing time = summarize(ms);
+        double median = time.median;
         t.row({std::string(bvhBuilderName(builder)), median,
                median / (double(mesh.mesh->triangleCount()) / 1e6), (long long)s.nodes,
                (long long)s.leaves, (long long)s.minLeafSize, s.meanLeafSize,
                (long long)s.maxLeafSize, (long long)s.depth, s.sahCost,
-               100.0 * (s.sahCost / sweep.sahCost - 1.0)});
+               100.0 * (s.sahCost / sweep.sahCost - 1.0), time.min, time.max});
     }
     return t;
 }
@@ -82,11 +94,13 @@ Table measureTraceSpeed(const NamedMesh& mesh, size_t rays, size_t bruteForceRay
     Table t;
     t.id = "bvh_trace";
     t.title = "Trace speed on '" + mesh.name + "', one thread, against brute force";
-    t.columns = {"builder",  "rays",  "Mrays/s", "build ms",
-                 "SAH cost", "hit %", "checked", "differ"};
+    t.columns = {"builder", "rays",   "Mrays/s", "build ms", "SAH cost", "hit %",
+                 "checked", "differ", "ns/ray",  "min ns",   "max ns"};
     t.note = std::to_string(rays) + " rays per kind, median of " + std::to_string(repeats) +
              " runs; 'differ': rays among the first " + std::to_string(bruteForceRays) +
-             " whose nearest hit is neither the brute-force triangle nor at its t";
+             " whose nearest hit is neither the brute-force triangle nor at its t; ns/ray: "
+             "median, min and max of the runs";
+    t.timeAndError("ns/ray", "min ns", "max ns", "differ");
     std::vector<std::vector<Ray>> sets;
     std::vector<std::vector<TraceHit>> reference;
     for (RayKind kind : {RayKind::Primary, RayKind::Diffuse, RayKind::Random}) {
@@ -101,7 +115,8 @@ Table measureTraceSpeed(const NamedMesh& mesh, size_t rays, size_t bruteForceRay
         BvhBuildStats stats;
         Bvh bvh = buildEngineBvh(*mesh.mesh, optionsFor(builder, bins), &stats);
         for (size_t k = 0; k < sets.size(); ++k) {
-            double mrays = traceMrays(bvh, sets[k], repeats, 1);
+            Timing time = traceTiming(bvh, sets[k], repeats, 1);
+            double mrays = 1e-6 / time.median;
             std::vector<TraceHit> hits;
             traceBatch(bvh, sets[k], hits, 1);
             size_t hit = 0, differ = 0;
@@ -111,7 +126,7 @@ Table measureTraceSpeed(const NamedMesh& mesh, size_t rays, size_t bruteForceRay
             t.row({std::string(bvhBuilderName(builder)) + " " + rayKindName(RayKind(k)),
                    (long long)sets[k].size(), mrays, stats.buildMs, stats.sahCost,
                    100.0 * double(hit) / double(hits.size()), (long long)reference[k].size(),
-                   (long long)differ});
+                   (long long)differ, time.median * 1e9, time.min * 1e9, time.max * 1e9});
         }
     }
     return t;
@@ -137,16 +152,33 @@ Table measureThreads(const NamedMesh& mesh, size_t rays, int repeats, uint64_t s
     return t;
 }
 
-Table measureTradeoff(const Table& traceSpeed) {
+Table measureTradeoff(const Table& traceSpeed, const Table& cracks) {
     Table t;
     t.id = "bvh_tradeoff";
-    t.title = "Build time against trace speed (primary rays, one thread)";
-    t.columns = {"builder", "build ms", "Mrays/s"};
+    t.title = "Build time, trace speed and rays lost per builder (primary rays, one thread)";
+    t.columns = {"builder", "build ms",  "Mrays/s", "ns/ray",       "min ns",
+                 "max ns",  "rays lost", "cracks",  "lost + cracks"};
+    t.note =
+        "time: a primary ray's (bvh_trace); rays lost: rays of every kind whose nearest hit "
+        "differs from brute force (bvh_trace's 'differ'); cracks: crack rays the tree lets "
+        "through on every mesh (bvh_cracks); the error is both together";
+    t.timeAndError("ns/ray", "min ns", "max ns", "lost + cracks");
+    auto number = [](const Cell& c) {
+        if (auto i = std::get_if<long long>(&c)) return double(*i);
+        return std::get<double>(c);
+    };
     for (const auto& row : traceSpeed.rows) {
         std::string name = std::get<std::string>(row[0]);
         if (!name.ends_with(" primary")) continue;
-        t.row(
-            {name.substr(0, name.size() - 8), std::get<double>(row[3]), std::get<double>(row[2])});
+        std::string builder = name.substr(0, name.size() - 8);
+        long long lost = 0, cracked = 0;
+        for (const auto& r : traceSpeed.rows)
+            if (std::get<std::string>(r[0]).starts_with(builder + " "))
+                lost += (long long)number(r[7]);
+        for (const auto& r : cracks.rows)
+            if (std::get<std::string>(r[1]) == builder) cracked += (long long)number(r[4]);
+        t.row({builder, number(row[3]), number(row[2]), number(row[8]), number(row[9]),
+               number(row[10]), lost, cracked, lost + cracked});
     }
     return t;
 }
@@ -164,16 +196,25 @@ void addMeasurements(Report& report, const NamedMesh& mesh, const Bvh& bvh,
     Mesh sh1 = loadObj(settings.dataDir + "/meshes/sh1.obj");
     Mesh bunny =
         mesh.name == "bunny" ? *mesh.mesh : loadObj(settings.dataDir + "/meshes/bunny.obj");
-    report.add(
-        measureBvhCracks({{"bunny", &bunny}, {"sh1", &sh1}}, settings.crackRays, settings.seed));
+    Table cracks =
+        measureBvhCracks({{"bunny", &bunny}, {"sh1", &sh1}}, settings.crackRays, settings.seed);
+    report.add(cracks);
     std::cerr << "04_bvh: culling...\n";
     report.add(measureCulling(mesh, bvh, 8));
-    report.add(measureTradeoff(speed));
+    report.add(measureTradeoff(speed, cracks));
     report.plots.push_back({{"table", "bvh_tradeoff"},
                             {"x", "build ms"},
                             {"y", "Mrays/s"},
                             {"series", "builder"},
                             {"title", "Builders: build time against trace speed"}});
+    report.plots.push_back({{"table", "bvh_tradeoff"},
+                            {"x", "ns/ray"},
+                            {"y", "lost + cracks"},
+                            {"series", "builder"},
+                            {"pareto", true},
+                            {"title",
+                             "Builders: rays lost (brute force) and cracks against time per "
+                             "primary ray, with the Pareto front"}});
 }
 
 void addTreeReport(Report& report, const Scene& scene, const MeshBvhGeometry& geometry,
@@ -204,12 +245,14 @@ Table measureCulling(const NamedMesh& mesh, const Bvh& bvh, int cameras) {
     Table t;
     t.id = "bvh_culling";
     t.title = "Frustum culling of the hierarchy on '" + mesh.name + "' (binned SAH tree)";
-    t.columns = {"view", "test",         "visited",        "culled",
-                 "kept", "wrongly kept", "kept triangles", "ms"};
+    t.columns = {"view",         "test",           "visited", "culled", "kept",
+                 "wrongly kept", "kept triangles", "ms",      "min ms", "max ms"};
     t.note =
         "views around the mesh, fov 40, far plane through the mesh's centre; 'wrongly "
         "kept': kept boxes that lie entirely outside the frustum (exact separating-axis "
-        "test); 'ms': culling traversal without the exact classification";
+        "test, the reference); 'ms': culling traversal without the exact classification, median "
+        "of 5 (min, max)";
+    t.timeAndError("ms", "min ms", "max ms", "wrongly kept");
     for (int i = 0; i < cameras; ++i) {
         CullingView v = cullingView(bvh.bounds(), i, cameras, 4.0f / 3.0f);
         Frustum f = makeFrustum(v.camera, v.nearDistance, v.farDistance);
@@ -220,7 +263,8 @@ Table measureCulling(const NamedMesh& mesh, const Bvh& bvh, int cameras) {
             t.row({(long long)i,
                    std::string(test == CullTest::Planes ? "planes" : "planes+corners"),
                    (long long)c.visited, (long long)c.culled, (long long)c.kept,
-                   (long long)c.wronglyKept, (long long)c.keptTriangles, time.median * 1e3});
+                   (long long)c.wronglyKept, (long long)c.keptTriangles, time.median * 1e3,
+                   time.min * 1e3, time.max * 1e3});
         }
     }
     return t;

@@ -30,9 +30,10 @@ Table measureThreads(const NamedMesh& mesh, size_t rays, int repeats, uint64_t s
 // enough that the frustum cuts it. Table id "bvh_culling".
 Table measureCulling(const NamedMesh& mesh, const Bvh& bvh, int cameras);
 
-// Build time against trace speed per builder (primary rays), from measureTraceSpeed's
-// table. Table id "bvh_tradeoff".
-Table measureTradeoff(const Table& traceSpeed);
+// Build time and trace speed per builder (primary rays) beside the rays it loses against
+// brute force and its cracks, from measureTraceSpeed's and measureBvhCracks's tables.
+// Table id "bvh_tradeoff".
+Table measureTradeoff(const Table& traceSpeed, const Table& cracks);
 
 // The whole `--measure` run on the scene's mesh and `bvh` (the program's tree), with the
 // crack count on the bunny and sh1 from dataDir, and the trade-off's plot.

@@ -27,6 +27,13 @@ double medianMs(int repeats, const std::function<void()>& fn) {
     return measure(repeats, fn).median * 1e3;
 }
 
+// The median, min and max of repeats in milliseconds.
+Timing timingMs(int repeats, const std::function<void()>& fn) {
+    Timing t = measure(repeats, fn);
+    t.median *= 1e3, t.min *= 1e3, t.max *= 1e3;
+    return t;
+}
+
 }  // namespace
 
 void attachGrid(Scene& scene) {
@@ -155,12 +162,22 @@ Table measureShadowBias(const MeasureView& v, const MeasureSettings& m) {
     Table t;
     t.id = "shadow_bias";
     t.title = "Shadow map depth bias against the ray tracer's shadows: acne and peter-panning";
-    t.columns = {"bias (x diagonal)", "acne pixels", "peter-panning pixels", "disagree %",
-                 "map size"};
-    t.note = v.name +
-             ", first light; acne: the map shadows a point the ray tracer lights; "
-             "peter-panning: the map lights a point the ray tracer shadows; over pixels where both "
-             "see the same triangle and the light can reach";
+    t.columns = {"bias (x diagonal)",
+                 "acne pixels",
+                 "peter-panning pixels",
+                 "disagree %",
+                 "map size",
+                 "ms map + shading",
+                 "min ms",
+                 "max ms"};
+    t.note =
+        v.name +
+        ", first light; acne: the map shadows a point the ray tracer lights; "
+        "peter-panning: the map lights a point the ray tracer shadows; over pixels where both "
+        "see the same triangle and the light can reach; ms: building the maps and shading, per "
+        "map size (the bias does not change the work), median of " +
+        std::to_string(m.repeats) + " (min, max), single thread";
+    t.timeAndError("ms map + shading", "min ms", "max ms", "disagree %");
     RasterScene raster = RasterScene::fromScene(v.scene);
     FrameBuffers buffers;
     rasterizeFrame(raster, v.camera, rasterSettings(m), buffers);
@@ -168,8 +185,15 @@ Table measureShadowBias(const MeasureView& v, const MeasureSettings& m) {
     std::vector<uint32_t> ids = meshIds(raster, buffers);
     for (int size : {m.mapSize() / 2, m.mapSize()}) {
         std::vector<ShadowMap> maps;
-        for (const PointLight& light : v.scene.lights)
-            maps.push_back(buildShadowMap(raster, light, size));
+        ShadeSettings timed;
+        timed.shadows = ShadowMode::Map;
+        timed.mapSize = size;
+        Timing ms = timingMs(m.repeats, [&] {
+            maps.clear();
+            for (const PointLight& light : v.scene.lights)
+                maps.push_back(buildShadowMap(raster, light, size));
+            keepValue(shadeFrame(v.scene, raster, v.camera, buffers, timed, &maps).milliseconds);
+        });
         for (double relative : {0.0, 1e-4, 3e-4, 1e-3, 3e-3, 1e-2, 3e-2}) {
             ShadeSettings ss;
             ss.shadows = ShadowMode::Map;
@@ -178,7 +202,7 @@ Table measureShadowBias(const MeasureView& v, const MeasureSettings& m) {
             ShadowComparison c =
                 compareShadows(ids, f.litByFirstLight, traced.ids, traced.litByFirstLight);
             t.row({relative, (long long)c.acne, (long long)c.leaks, 100.0 * c.disagreement(),
-                   (long long)size});
+                   (long long)size, ms.median, ms.min, ms.max});
         }
     }
     return t;
@@ -188,9 +212,12 @@ Table measureShadowMethods(const MeasureView& v, const MeasureSettings& m) {
     Table t;
     t.id = "shadows";
     t.title = "Shadows two ways against the ray tracer's shadow rays";
-    t.columns = {"method", "pixels compared", "disagree", "disagree %", "ms per frame"};
+    t.columns = {"method",       "pixels compared", "disagree", "disagree %",
+                 "ms per frame", "min ms",          "max ms"};
     t.note = v.name + ", first light, single thread, median of " + std::to_string(m.repeats) +
-             "; the frame time includes rasterizing and shading (and building the map)";
+             " (min, max); the frame time includes rasterizing and shading (and building the map); "
+             "the reference: the ray tracer's shadow rays (its time: 2 frames)";
+    t.timeAndError("ms per frame", "min ms", "max ms", "disagree %");
     RasterScene raster = RasterScene::fromScene(v.scene);
     RasterSettings rs = rasterSettings(m);
     FrameBuffers buffers;
@@ -200,14 +227,14 @@ Table measureShadowMethods(const MeasureView& v, const MeasureSettings& m) {
         ss.shadows = mode;
         ss.mapSize = m.mapSize();
         ShadedFrame f;
-        double ms = medianMs(m.repeats, [&] {
+        Timing ms = timingMs(m.repeats, [&] {
             rasterizeFrame(raster, v.camera, rs, buffers);
             f = shadeFrame(v.scene, raster, v.camera, buffers, ss);
         });
         ShadowComparison c = compareShadows(meshIds(raster, buffers), f.litByFirstLight, traced.ids,
                                             traced.litByFirstLight);
         t.row({std::string(shadowModeName(mode)), (long long)c.compared,
-               (long long)(c.acne + c.leaks), 100.0 * c.disagreement(), ms});
+               (long long)(c.acne + c.leaks), 100.0 * c.disagreement(), ms.median, ms.min, ms.max});
     }
     {
         // The hybrid again, its shadow rays through step 04's hierarchy instead of the grid.
@@ -219,17 +246,23 @@ Table measureShadowMethods(const MeasureView& v, const MeasureSettings& m) {
         ShadeSettings ss;
         ss.shadows = ShadowMode::Rays;
         ShadedFrame f;
-        double ms = medianMs(m.repeats, [&] {
+        Timing ms = timingMs(m.repeats, [&] {
             rasterizeFrame(raster, v.camera, rs, buffers);
             f = shadeFrame(bvhScene, raster, v.camera, buffers, ss);
         });
         ShadowComparison c = compareShadows(meshIds(raster, buffers), f.litByFirstLight, traced.ids,
                                             traced.litByFirstLight);
         t.row({std::string("shadow rays (hybrid) through step 04's BVH"), (long long)c.compared,
-               (long long)(c.acne + c.leaks), 100.0 * c.disagreement(), ms});
+               (long long)(c.acne + c.leaks), 100.0 * c.disagreement(), ms.median, ms.min, ms.max});
     }
-    t.row(
-        {std::string("ray tracer (visibility + shadow rays)"), 0LL, 0LL, 0.0, traced.milliseconds});
+    // The reference itself: its frame above and one more (the slowest frame of the table,
+    // so two samples, not m.repeats).
+    std::vector<double> tracedMs = {
+        traced.milliseconds,
+        traceFrame(v.scene, v.camera, m.width, m.height, true, 1).milliseconds};
+    Timing tracedTime = summarize(tracedMs);
+    t.row({std::string("ray tracer (visibility + shadow rays)"), 0LL, 0LL, 0.0, tracedTime.median,
+           tracedTime.min, tracedTime.max});
     return t;
 }
 
@@ -240,13 +273,15 @@ Table measureCulling(const std::vector<MeasureView>& views, const MeasureSetting
         "View-frustum culling with step 04's hierarchy: boxes culled and kept, triangles drawn";
     t.columns = {"view",       "test",           "boxes visited",   "boxes culled",
                  "boxes kept", "triangles kept", "triangles drawn", "ms per frame",
-                 "identical"};
+                 "identical",  "min ms",         "max ms",          "pixels differing"};
     t.note =
         "binned-SAH hierarchy over the mesh; test: none, planes (p-vertex), planes + corners; "
         "ms: median of " +
         std::to_string(m.repeats) +
-        " frames (culling walk + rasterizing, single thread); identical: the triangle "
-        "and depth buffers equal the unculled frame's";
+        " frames (culling walk + rasterizing, single thread; min, max); identical: the triangle "
+        "and depth buffers equal the unculled frame's; pixels differing: pixels where either "
+        "buffer differs from the unculled frame's, the reference";
+    t.timeAndError("ms per frame", "min ms", "max ms", "pixels differing");
     std::vector<MeasureView> cases;
     for (const MeasureView& v : views) cases.push_back(v);
     // The bunny's head from close by: a good share of the mesh lies outside the view.
@@ -268,15 +303,20 @@ Table measureCulling(const std::vector<MeasureView>& views, const MeasureSetting
             const FrustumCuller* c = test < 0 ? nullptr : &culler;
             CullTest which = test == 1 ? CullTest::PlanesAndCorners : CullTest::Planes;
             FrameStats stats;
-            double ms = medianMs(m.repeats, [&] {
+            Timing ms = timingMs(m.repeats, [&] {
                 stats = rasterizeCulled(raster, c, v.camera, rs, buffers, cull, which);
             });
             bool same = buffers.triangle == reference.triangle && buffers.depth == reference.depth;
+            long long differing = 0;
+            for (size_t i = 0; i < buffers.triangle.size(); ++i)
+                differing += buffers.triangle[i] != reference.triangle[i] ||
+                             !(buffers.depth[i] == reference.depth[i]);
             const char* name = test < 0 ? "none" : test == 0 ? "planes" : "planes + corners";
             t.row({v.name, std::string(name), (long long)cull.boxesVisited,
                    (long long)cull.boxesCulled, (long long)cull.boxesKept,
                    (long long)(c ? cull.trianglesKept : raster.meshTriangles),
-                   (long long)stats.trianglesDrawn, ms, std::string(same ? "yes" : "NO")});
+                   (long long)stats.trianglesDrawn, ms.median, std::string(same ? "yes" : "NO"),
+                   ms.min, ms.max, differing});
         }
     }
     return t;
@@ -289,10 +329,14 @@ Table measureInterpolation(const MeasureView& bunny, const MeasureSettings& m,
     t.id = "interpolation";
     t.title =
         "Affine against perspective-correct interpolation: position error against the ray tracer";
-    t.columns = {"view", "weights", "mean error (x diagonal)", "max error (x diagonal)"};
+    t.columns = {
+        "view",   "weights", "mean error (x diagonal)", "max error (x diagonal)", "ms/frame",
+        "min ms", "max ms"};
     t.note =
         "the interpolated surface point against the ray tracer's hit point, over pixels where "
-        "both see the same triangle";
+        "both see the same triangle; ms/frame: rasterizing with those weights, median of " +
+        std::to_string(m.repeats) + " (min, max), single thread";
+    t.timeAndError("ms/frame", "min ms", "max ms", "max error (x diagonal)");
     // A floor of two triangles seen at a grazing angle: large triangles, strong perspective.
     MeasureView floor{"floor quad (grazing)", Scene{}, {}};
     floor.scene.name = "floor";
@@ -311,7 +355,8 @@ Table measureInterpolation(const MeasureView& bunny, const MeasureSettings& m,
             RasterSettings rs = rasterSettings(m);
             rs.perspectiveCorrect = correct;
             FrameBuffers buffers;
-            rasterizeFrame(raster, v->camera, rs, buffers);
+            Timing ms =
+                timingMs(m.repeats, [&] { rasterizeFrame(raster, v->camera, rs, buffers); });
             double sum = 0.0, worst = 0.0;
             size_t n = 0;
             for (int y = 0; y < m.height; ++y)
@@ -331,7 +376,7 @@ Table measureInterpolation(const MeasureView& bunny, const MeasureSettings& m,
                     ++n;
                 }
             t.row({v->name, std::string(correct ? "perspective-correct" : "affine"),
-                   n ? sum / double(n) : 0.0, worst});
+                   n ? sum / double(n) : 0.0, worst, ms.median, ms.min, ms.max});
             if (v == &floor && !pngStem.empty()) {
                 ShadeSettings ss;
                 ss.shadows = ShadowMode::None;
@@ -570,6 +615,15 @@ void measureRaster(const StepRun& run, Report& report) {
          {"series", "map size"},
          {"logx", true},
          {"title", "Shadow map bias: acne at small bias, peter-panning at large"}});
+    report.plots.push_back(
+        {{"table", "shadows"},
+         {"x", "ms per frame"},
+         {"y", "disagree %"},
+         {"series", "method"},
+         {"pareto", true},
+         {"title",
+          "Shadows: pixels that disagree with the ray tracer against time per frame, with the "
+          "Pareto front"}});
 }
 
 }  // namespace boxes

@@ -5,6 +5,7 @@
 #include "01_triangle/measure.hpp"
 #include "04_bvh/advanced/build.hpp"
 #include "04_bvh/advanced/bvh4.hpp"
+#include "core/timing.hpp"
 
 namespace boxes {
 
@@ -12,11 +13,14 @@ Table measureBvhCracks(const std::vector<NamedMesh>& meshes, size_t raysPerFeatu
     Table t;
     t.id = "bvh_cracks";
     t.title = "Cracks through the hierarchy: rays aimed at shared edges and vertices";
-    t.columns = {"mesh", "builder", "feature", "rays", "cracks", "differ from brute force"};
+    t.columns = {"mesh",   "builder", "feature", "rays", "cracks", "differ from brute force",
+                 "ns/ray", "min ns",  "max ns"};
     t.note =
         "a crack: a ray that some triangle at the feature hits, for which the hierarchy "
         "reports nothing as near; watertight leaf test, conservative box test; 'differ' "
-        "over the first 200 rays per row against brute force";
+        "over the first 200 rays per row against brute force; ns/ray: the row's rays traced, "
+        "median of 3 passes, one thread";
+    t.timeAndError("ns/ray", "min ns", "max ns", "cracks");
     for (const NamedMesh& m : meshes) {
         CrackRaySet set = makeCrackRays(*m.mesh, raysPerFeature, raysPerFeature, seed);
         // The exercise builders, the SAH with spatial splits (whose split planes cut
@@ -39,11 +43,18 @@ Table measureBvhCracks(const std::vector<NamedMesh>& meshes, size_t raysPerFeatu
             Bvh8 bvh8 = width == 8 ? collapseToBvh8(bvh) : Bvh8{};
             for (int feature = 0; feature < 2; ++feature) {
                 const auto& rays = feature == 0 ? set.edgeRays : set.vertexRays;
+                auto trace = [&](const Ray& ray) {
+                    return width == 4   ? traceNearest(bvh4, ray)
+                           : width == 8 ? traceNearest(bvh8, ray)
+                                        : traceNearest(bvh, ray);
+                };
+                Timing time = measure(3, [&] {
+                    for (const CrackRay& cr : rays) keepValue(trace(cr.ray).t);
+                });
+                double scale = 1e9 / double(std::max<size_t>(1, rays.size()));
                 size_t cracks = 0, differ = 0;
                 for (const CrackRay& cr : rays) {
-                    TraceHit h = width == 4   ? traceNearest(bvh4, cr.ray)
-                                 : width == 8 ? traceNearest(bvh8, cr.ray)
-                                              : traceNearest(bvh, cr.ray);
+                    TraceHit h = trace(cr.ray);
                     float target = kInfinity<float>;
                     WatertightRay w(cr.ray);
                     for (uint32_t tri : cr.triangles) {
@@ -59,7 +70,8 @@ Table measureBvhCracks(const std::vector<NamedMesh>& meshes, size_t raysPerFeatu
                        width > 2 ? "sah " + std::to_string(width) + "-wide"
                                  : std::string(bvhBuilderName(builder)),
                        std::string(feature == 0 ? "edges" : "vertices"), (long long)rays.size(),
-                       (long long)cracks, (long long)differ});
+                       (long long)cracks, (long long)differ, time.median * scale, time.min * scale,
+                       time.max * scale});
             }
         }
     }

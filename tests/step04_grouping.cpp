@@ -20,8 +20,8 @@ struct Wall {
     float c, m;
 };
 // Slots 0-1 in G1, 2-3 in G2, 4-5 in G3, 6-7 in G4.
-constexpr Wall kWalls[8] = {{2, 2},  {3, 4.5f}, {1, 5},  {2, 6.5f},
-                            {6, 4},  {7, 2},    {9, 6.5f}, {10, 6}};
+constexpr Wall kWalls[8] = {{2, 2}, {3, 4.5f}, {1, 5},    {2, 6.5f},
+                            {6, 4}, {7, 2},    {9, 6.5f}, {10, 6}};
 
 Mesh groupingMesh() {
     Mesh m;

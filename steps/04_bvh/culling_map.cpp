@@ -51,6 +51,86 @@ void fillRect(Image& image, int x0, int width, Vec2 lo, Vec2 hi, Vec3 colour, fl
             plot(image, x0, width, x, y, colour, alpha);
 }
 
+// The legend's letters, 5 x 7 pixels each (one string per row, '#' set): only those of
+// "culled", "kept", "wrongly kept" and "frustum". The core draws no text outside the
+// window's panel, and the headless map needs its legend in the picture.
+struct Glyph {
+    char letter;
+    const char* rows[7];
+};
+constexpr Glyph kGlyphs[] = {
+    {'c', {".....", ".....", ".###.", "#....", "#....", "#....", ".###."}},
+    {'d', {"....#", "....#", ".####", "#...#", "#...#", "#...#", ".####"}},
+    {'e', {".....", ".....", ".###.", "#...#", "#####", "#....", ".###."}},
+    {'f', {"..##.", ".#..#", ".#...", "###..", ".#...", ".#...", ".#..."}},
+    {'g', {".....", ".....", ".####", "#...#", ".####", "....#", ".###."}},
+    {'k', {"#....", "#....", "#..#.", "#.#..", "##...", "#.#..", "#..#."}},
+    {'l', {".##..", "..#..", "..#..", "..#..", "..#..", "..#..", ".###."}},
+    {'m', {".....", ".....", "##.#.", "#.#.#", "#.#.#", "#.#.#", "#...#"}},
+    {'n', {".....", ".....", "#.##.", "##..#", "#...#", "#...#", "#...#"}},
+    {'o', {".....", ".....", ".###.", "#...#", "#...#", "#...#", ".###."}},
+    {'p', {".....", ".....", "####.", "#...#", "####.", "#....", "#...."}},
+    {'r', {".....", ".....", "#.##.", "##..#", "#....", "#....", "#...."}},
+    {'s', {".....", ".....", ".####", "#....", ".###.", "....#", "####."}},
+    {'t', {".#...", ".#...", "###..", ".#...", ".#...", ".#..#", "..##."}},
+    {'u', {".....", ".....", "#...#", "#...#", "#...#", "#..##", ".##.#"}},
+    {'w', {".....", ".....", "#...#", "#...#", "#.#.#", "#.#.#", ".#.#."}},
+    {'y', {".....", ".....", "#...#", "#...#", ".####", "....#", ".###."}},
+};
+
+// Draws `text` with its top left at (x, y), each font pixel `scale` pixels; returns the
+// x after it. Letters the font lacks (and spaces) advance without drawing.
+int drawText(Image& image, int x0, int width, int x, int y, const char* text, int scale,
+             Vec3 colour) {
+    for (; *text; ++text, x += 6 * scale) {
+        for (const Glyph& g : kGlyphs) {
+            if (g.letter != *text) continue;
+            for (int row = 0; row < 7; ++row)
+                for (int col = 0; col < 5; ++col)
+                    if (g.rows[row][col] == '#')
+                        for (int k = 0; k < scale * scale; ++k)
+                            plot(image, x0, width, x + col * scale + k % scale,
+                                 y + row * scale + k / scale, colour);
+        }
+    }
+    return x;
+}
+
+// The legend: a strip of two lines at the bottom, a colour sample and its meaning each.
+int legendScale(int width, int height) {
+    return width < 150 || height < 100 ? 0 : height >= 250 && width >= 320 ? 2 : 1;
+}
+int legendHeight(int width, int height) {
+    return 22 * legendScale(width, height);
+}
+void drawLegend(Image& image, int x0, int width, const Vec3 colours[4], Vec3 frustumColour) {
+    int scale = legendScale(width, image.height());
+    if (scale == 0) return;
+    int lineHeight = 9 * scale, top = image.height() - legendHeight(width, image.height());
+    for (int y = top; y < image.height(); ++y)
+        for (int x = 0; x < width; ++x) image.at(x0 + x, y) = Vec3(0.0f);
+    struct Entry {
+        Vec3 colour;
+        const char* text;
+        bool filled;
+    };
+    const Entry entries[2][2] = {
+        {{colours[1], "culled", false}, {colours[2], "kept", false}},
+        {{colours[3], "wrongly kept", true}, {frustumColour, "frustum", false}}};
+    for (int r = 0; r < 2; ++r) {
+        int x = 4 * scale, y = top + 2 * scale + r * lineHeight;
+        for (const Entry& e : entries[r]) {
+            Vec2 lo{float(x), float(y)}, hi{float(x + 7 * scale), float(y + 7 * scale)};
+            if (e.filled) fillRect(image, x0, width, lo, hi, e.colour, 0.35f);
+            line(image, x0, width, lo, Vec2(hi.x, lo.y), e.colour, scale);
+            line(image, x0, width, Vec2(hi.x, lo.y), hi, e.colour, scale);
+            line(image, x0, width, hi, Vec2(lo.x, hi.y), e.colour, scale);
+            line(image, x0, width, Vec2(lo.x, hi.y), lo, e.colour, scale);
+            x = drawText(image, x0, width, x + 10 * scale, y, e.text, scale, Vec3(0.8f));
+            x += 10 * scale;
+        }
+    }
+}
 }  // namespace
 
 void drawCullingMap(Image& image, int x0, int width, const Bvh& bvh, const Frustum& frustum,
@@ -78,10 +158,11 @@ void drawCullingMap(Image& image, int x0, int width, const Bvh& bvh, const Frust
         regionHi = glm::max(regionHi, project(frustum.corners[size_t(i)]));
     }
     Vec2 centre = 0.5f * (regionLo + regionHi), size = glm::max(regionHi - regionLo, Vec2(1e-30f));
-    float scale = 0.92f * std::min(float(width) / size.x, float(image.height()) / size.y);
+    float mapHeight = float(image.height() - legendHeight(width, image.height()));
+    float scale = 0.92f * std::min(float(width) / size.x, mapHeight / size.y);
     auto toMap = [&](Vec3 p) {
         Vec2 d = project(p) - centre;
-        return Vec2(0.5f * float(width) + d.x * scale, 0.5f * float(image.height()) - d.y * scale);
+        return Vec2(0.5f * float(width) + d.x * scale, 0.5f * mapHeight - d.y * scale);
     };
     // The frustum's footprint (the convex hull of its corners on the map), tinted first:
     // what lies inside it on the map, and what does not, at a glance.
@@ -97,7 +178,8 @@ void drawCullingMap(Image& image, int x0, int width, const Bvh& bvh, const Frust
         for (int pass = 0; pass < 2; ++pass) {
             size_t start = hull.size();
             for (Vec2 q : points) {
-                while (hull.size() >= start + 2 && cross(hull[hull.size() - 2], hull.back(), q) <= 0)
+                while (hull.size() >= start + 2 &&
+                       cross(hull[hull.size() - 2], hull.back(), q) <= 0)
                     hull.pop_back();
                 hull.push_back(q);
             }
@@ -158,9 +240,11 @@ void drawCullingMap(Image& image, int x0, int width, const Bvh& bvh, const Frust
     const auto& k = frustum.corners;
     const int edges[12][2] = {{0, 1}, {1, 3}, {3, 2}, {2, 0}, {4, 5}, {5, 7},
                               {7, 6}, {6, 4}, {0, 4}, {1, 5}, {2, 6}, {3, 7}};
+    const Vec3 frustumColour(0.25f, 0.55f, 1.0f);
     for (const auto& e : edges)
-        line(image, x0, width, toMap(k[size_t(e[0])]), toMap(k[size_t(e[1])]),
-             Vec3(0.25f, 0.55f, 1.0f), thickness);
+        line(image, x0, width, toMap(k[size_t(e[0])]), toMap(k[size_t(e[1])]), frustumColour,
+             thickness);
+    drawLegend(image, x0, width, colours, frustumColour);
 }
 
 void addCullingMap(Report& report, const Bvh& bvh, const std::string& png, int width, int height,
@@ -172,10 +256,11 @@ void addCullingMap(Report& report, const Bvh& bvh, const std::string& png, int w
     std::string path = pngWithSuffix(png, "-cull");
     map.writePng(path);
     report.images.push_back({path,
-                             "the hierarchy from above (depth 6) and the frustum, tinted blue: "
-                             "grey boxes culled by the plane test, green kept, red kept although "
-                             "outside (seen from above a red box can overlap the frustum: it "
-                             "passes over or under it)"});
+                             "the hierarchy from above (depth 6) and a camera's frustum (its "
+                             "footprint tinted), the boxes coloured by the plane test as the "
+                             "legend says: red ones are kept although entirely outside (seen "
+                             "from above a red box can overlap the footprint: it passes over or "
+                             "under the frustum)"});
 }
 
 std::vector<KeyBinding> CullingMapWindow::keys() {

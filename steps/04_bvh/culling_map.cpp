@@ -97,8 +97,10 @@ int drawText(Image& image, int x0, int width, int x, int y, const char* text, in
 }
 
 // The legend: a strip of two lines at the bottom, a colour sample and its meaning each.
+// Font pixels per image pixel: about a 20th of the height, and the widest line (162 font
+// pixels) within the width; 0 (no legend) on maps too small for it.
 int legendScale(int width, int height) {
-    return width < 150 || height < 100 ? 0 : height >= 250 && width >= 320 ? 2 : 1;
+    return width < 170 || height < 100 ? 0 : std::max(1, std::min(height / 150, width / 170));
 }
 int legendHeight(int width, int height) {
     return 22 * legendScale(width, height);

@@ -258,11 +258,9 @@ void addCullingMap(Report& report, const Bvh& bvh, const std::string& png, int w
     std::string path = pngWithSuffix(png, "-cull");
     map.writePng(path);
     report.images.push_back({path,
-                             "the hierarchy from above (depth 6) and a camera's frustum (its "
-                             "footprint tinted), the boxes coloured by the plane test as the "
-                             "legend says: red ones are kept although entirely outside (seen "
-                             "from above a red box can overlap the footprint: it passes over or "
-                             "under the frustum)"});
+                             "the hierarchy from above (depth 6) coloured by the plane test, and "
+                             "a camera's frustum; a red box over the frustum's tinted footprint "
+                             "passes above or below it"});
 }
 
 std::vector<KeyBinding> CullingMapWindow::keys() {

@@ -8,7 +8,8 @@
 //   <!-- check: 03_aabb:slab_accuracy[robust]{ns/test} > 1.2 * 03_aabb:slab_accuracy[naive (slide]{ns/test} -->
 //
 // A reference is STEP:TABLE[ROW]{COLUMN}: the table with that id, the one row whose cells
-// (joined by spaces) contain ROW, the cell of that column; STEP:facts{NAME} is a fact. Both
+// (joined by spaces) contain ROW (of several, the one where ROW is whole cells), the cell
+// of that column; STEP:facts{NAME} is a fact. Both
 // sides are numbers, references, or products and quotients of them; the operators are
 // ==, !=, <, <=, >, >=. Every `<!-- fact: STEP/NAME -->` placeholder of a measured step must
 // name a fact of its report too.
@@ -91,7 +92,15 @@ function resolve(step, table, row, column) {
   if (!t) throw new Error(`out/${step}.json has no table '${table}'`);
   const c = t.columns.indexOf(column);
   if (c < 0) throw new Error(`table ${step}:${table} has no column '${column}' (columns: ${t.columns.join(", ")})`);
-  const rows = t.rows.filter((cells) => cells.map(String).join(" ").includes(row || ""));
+  let rows = t.rows.filter((cells) => cells.map(String).join(" ").includes(row || ""));
+  // A name inside another ("sah" in "sweep-sah", "bunny planes" in "bunny planes + corners"):
+  // the one row where it is whole cells, one cell or a run of them.
+  if (rows.length > 1) {
+    const whole = (cells) =>
+      cells.some((_, i) => cells.slice(i).some((__, j) => cells.slice(i, i + j + 1).map(String).join(" ") === row));
+    const exact = rows.filter(whole);
+    if (exact.length === 1) rows = exact;
+  }
   if (rows.length !== 1)
     throw new Error(`table ${step}:${table}: ${rows.length} rows contain '${row}' (need exactly one)`);
   const v = rows[0][c];

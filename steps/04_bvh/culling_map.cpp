@@ -26,45 +26,182 @@ CullingView cullingView(const Bounds3f& bounds, int index, int count, float aspe
 
 namespace {
 
-void plot(Image& image, int x0, int width, int x, int y, Vec3 colour) {
+void plot(Image& image, int x0, int width, int x, int y, Vec3 colour, float alpha = 1.0f) {
     if (x < 0 || x >= width || y < 0 || y >= image.height()) return;
-    image.at(x0 + x, y) = colour;
+    Vec3& p = image.at(x0 + x, y);
+    p = alpha * colour + (1.0f - alpha) * p;
 }
 
-void line(Image& image, int x0, int width, Vec2 a, Vec2 b, Vec3 colour) {
+// A line `thickness` pixels wide (1 or 2: the second row or column below or to the right).
+void line(Image& image, int x0, int width, Vec2 a, Vec2 b, Vec3 colour, int thickness = 1) {
     float length = std::max(std::abs(b.x - a.x), std::abs(b.y - a.y));
     int steps = int(std::min(4096.0f, std::ceil(length))) + 1;
+    bool steep = std::abs(b.y - a.y) > std::abs(b.x - a.x);
     for (int i = 0; i <= steps; ++i) {
         Vec2 p = a + (b - a) * (float(i) / float(steps));
-        plot(image, x0, width, int(std::floor(p.x)), int(std::floor(p.y)), colour);
+        int x = int(std::floor(p.x)), y = int(std::floor(p.y));
+        for (int k = 0; k < thickness; ++k)
+            plot(image, x0, width, steep ? x + k : x, steep ? y : y + k, colour);
     }
 }
 
+void fillRect(Image& image, int x0, int width, Vec2 lo, Vec2 hi, Vec3 colour, float alpha) {
+    for (int y = int(std::ceil(lo.y)); y < int(std::ceil(hi.y)); ++y)
+        for (int x = int(std::ceil(lo.x)); x < int(std::ceil(hi.x)); ++x)
+            plot(image, x0, width, x, y, colour, alpha);
+}
+
+// The legend's letters, 5 x 7 pixels each (one string per row, '#' set): only those of
+// "culled", "kept", "wrongly kept" and "frustum". The core draws no text outside the
+// window's panel, and the headless map needs its legend in the picture.
+struct Glyph {
+    char letter;
+    const char* rows[7];
+};
+constexpr Glyph kGlyphs[] = {
+    {'c', {".....", ".....", ".###.", "#....", "#....", "#....", ".###."}},
+    {'d', {"....#", "....#", ".####", "#...#", "#...#", "#...#", ".####"}},
+    {'e', {".....", ".....", ".###.", "#...#", "#####", "#....", ".###."}},
+    {'f', {"..##.", ".#..#", ".#...", "###..", ".#...", ".#...", ".#..."}},
+    {'g', {".....", ".....", ".####", "#...#", ".####", "....#", ".###."}},
+    {'k', {"#....", "#....", "#..#.", "#.#..", "##...", "#.#..", "#..#."}},
+    {'l', {".##..", "..#..", "..#..", "..#..", "..#..", "..#..", ".###."}},
+    {'m', {".....", ".....", "##.#.", "#.#.#", "#.#.#", "#.#.#", "#...#"}},
+    {'n', {".....", ".....", "#.##.", "##..#", "#...#", "#...#", "#...#"}},
+    {'o', {".....", ".....", ".###.", "#...#", "#...#", "#...#", ".###."}},
+    {'p', {".....", ".....", "####.", "#...#", "####.", "#....", "#...."}},
+    {'r', {".....", ".....", "#.##.", "##..#", "#....", "#....", "#...."}},
+    {'s', {".....", ".....", ".####", "#....", ".###.", "....#", "####."}},
+    {'t', {".#...", ".#...", "###..", ".#...", ".#...", ".#..#", "..##."}},
+    {'u', {".....", ".....", "#...#", "#...#", "#...#", "#..##", ".##.#"}},
+    {'w', {".....", ".....", "#...#", "#...#", "#.#.#", "#.#.#", ".#.#."}},
+    {'y', {".....", ".....", "#...#", "#...#", ".####", "....#", ".###."}},
+};
+
+// Draws `text` with its top left at (x, y), each font pixel `scale` pixels; returns the
+// x after it. Letters the font lacks (and spaces) advance without drawing.
+int drawText(Image& image, int x0, int width, int x, int y, const char* text, int scale,
+             Vec3 colour) {
+    for (; *text; ++text, x += 6 * scale) {
+        for (const Glyph& g : kGlyphs) {
+            if (g.letter != *text) continue;
+            for (int row = 0; row < 7; ++row)
+                for (int col = 0; col < 5; ++col)
+                    if (g.rows[row][col] == '#')
+                        for (int k = 0; k < scale * scale; ++k)
+                            plot(image, x0, width, x + col * scale + k % scale,
+                                 y + row * scale + k / scale, colour);
+        }
+    }
+    return x;
+}
+
+// The legend: a strip of two lines at the bottom, a colour sample and its meaning each.
+// Font pixels per image pixel: about a 20th of the height, and the widest line (162 font
+// pixels) within the width; 0 (no legend) on maps too small for it.
+int legendScale(int width, int height) {
+    return width < 170 || height < 100 ? 0 : std::max(1, std::min(height / 150, width / 170));
+}
+int legendHeight(int width, int height) {
+    return 22 * legendScale(width, height);
+}
+void drawLegend(Image& image, int x0, int width, const Vec3 colours[4], Vec3 frustumColour) {
+    int scale = legendScale(width, image.height());
+    if (scale == 0) return;
+    int lineHeight = 9 * scale, top = image.height() - legendHeight(width, image.height());
+    for (int y = top; y < image.height(); ++y)
+        for (int x = 0; x < width; ++x) image.at(x0 + x, y) = Vec3(0.0f);
+    struct Entry {
+        Vec3 colour;
+        const char* text;
+        bool filled;
+    };
+    const Entry entries[2][2] = {
+        {{colours[1], "culled", false}, {colours[2], "kept", false}},
+        {{colours[3], "wrongly kept", true}, {frustumColour, "frustum", false}}};
+    for (int r = 0; r < 2; ++r) {
+        int x = 4 * scale, y = top + 2 * scale + r * lineHeight;
+        for (const Entry& e : entries[r]) {
+            Vec2 lo{float(x), float(y)}, hi{float(x + 7 * scale), float(y + 7 * scale)};
+            if (e.filled) fillRect(image, x0, width, lo, hi, e.colour, 0.35f);
+            line(image, x0, width, lo, Vec2(hi.x, lo.y), e.colour, scale);
+            line(image, x0, width, Vec2(hi.x, lo.y), hi, e.colour, scale);
+            line(image, x0, width, hi, Vec2(lo.x, hi.y), e.colour, scale);
+            line(image, x0, width, Vec2(lo.x, hi.y), lo, e.colour, scale);
+            x = drawText(image, x0, width, x + 10 * scale, y, e.text, scale, Vec3(0.8f));
+            x += 10 * scale;
+        }
+    }
+}
 }  // namespace
 
 void drawCullingMap(Image& image, int x0, int width, const Bvh& bvh, const Frustum& frustum,
                     CullTest test, int level, Vec3 up) {
     for (int y = 0; y < image.height(); ++y)
-        for (int x = 0; x < width; ++x) image.at(x0 + x, y) = Vec3(0.08f);
+        for (int x = 0; x < width; ++x) image.at(x0 + x, y) = Vec3(0.004f);
     if (bvh.empty()) return;
     // Map axes: two directions perpendicular to up.
     up = glm::normalize(up);
     Vec3 across = std::abs(up.x) < 0.9f ? Vec3(1, 0, 0) : Vec3(0, 0, 1);
     Vec3 mapX = glm::normalize(across - glm::dot(across, up) * up);
     Vec3 mapY = glm::cross(up, mapX);
-    Bounds3f region = bvh.bounds();
-    region.extend(frustum.corners[0]);  // the eye's neighbourhood
-    Vec3 centre = region.centroid();
-    float extent = 0.6f * glm::length(region.diagonal());
-    float scale = 0.5f * float(std::min(width, image.height())) / extent;
+    auto project = [&](Vec3 p) { return Vec2(glm::dot(p, mapX), glm::dot(p, mapY)); };
+    // The view fits what the map is about: the hierarchy's box and the frustum, with a
+    // margin of 4% on each side, the same scale on both axes.
+    Vec2 regionLo(kInfinity<float>), regionHi(-kInfinity<float>);
+    const BvhNode& root = bvh.nodes[0];
+    for (int i = 0; i < 8; ++i) {
+        Vec3 p(i & 1 ? root.boundsMax.x : root.boundsMin.x,
+               i & 2 ? root.boundsMax.y : root.boundsMin.y,
+               i & 4 ? root.boundsMax.z : root.boundsMin.z);
+        regionLo = glm::min(regionLo, project(p));
+        regionHi = glm::max(regionHi, project(p));
+        regionLo = glm::min(regionLo, project(frustum.corners[size_t(i)]));
+        regionHi = glm::max(regionHi, project(frustum.corners[size_t(i)]));
+    }
+    Vec2 centre = 0.5f * (regionLo + regionHi), size = glm::max(regionHi - regionLo, Vec2(1e-30f));
+    float mapHeight = float(image.height() - legendHeight(width, image.height()));
+    float scale = 0.92f * std::min(float(width) / size.x, mapHeight / size.y);
     auto toMap = [&](Vec3 p) {
-        Vec3 d = p - centre;
-        return Vec2(0.5f * float(width) + glm::dot(d, mapX) * scale,
-                    0.5f * float(image.height()) - glm::dot(d, mapY) * scale);
+        Vec2 d = project(p) - centre;
+        return Vec2(0.5f * float(width) + d.x * scale, 0.5f * mapHeight - d.y * scale);
     };
+    // The frustum's footprint (the convex hull of its corners on the map), tinted first:
+    // what lies inside it on the map, and what does not, at a glance.
+    {
+        std::vector<Vec2> hull;  // Andrew's monotone chain, counter-clockwise
+        std::vector<Vec2> points;
+        for (const Vec3& c : frustum.corners) points.push_back(toMap(c));
+        std::sort(points.begin(), points.end(),
+                  [](Vec2 a, Vec2 b) { return a.x < b.x || (a.x == b.x && a.y < b.y); });
+        auto cross = [](Vec2 o, Vec2 a, Vec2 b) {
+            return (a.x - o.x) * (b.y - o.y) - (a.y - o.y) * (b.x - o.x);
+        };
+        for (int pass = 0; pass < 2; ++pass) {
+            size_t start = hull.size();
+            for (Vec2 q : points) {
+                while (hull.size() >= start + 2 &&
+                       cross(hull[hull.size() - 2], hull.back(), q) <= 0)
+                    hull.pop_back();
+                hull.push_back(q);
+            }
+            hull.pop_back();
+            std::reverse(points.begin(), points.end());
+        }
+        for (int y = 0; y < image.height(); ++y)
+            for (int x = 0; x < width; ++x) {
+                Vec2 q(float(x) + 0.5f, float(y) + 0.5f);
+                bool inside = hull.size() >= 3;
+                for (size_t i = 0; i < hull.size() && inside; ++i)
+                    inside = cross(hull[i], hull[(i + 1) % hull.size()], q) >= 0;
+                if (inside) plot(image, x0, width, x, y, Vec3(0.02f, 0.05f, 0.12f));
+            }
+    }
     std::vector<NodeVisibility> verdict = classifyNodes(bvh, frustum, test);
-    const Vec3 colours[] = {Vec3(0.25f), Vec3(0.35f), Vec3(0.2f, 0.85f, 0.3f),
-                            Vec3(1.0f, 0.2f, 0.2f)};
+    // Not visited (below a culled box) and culled are both grey: culled, as far as the
+    // renderer is concerned. Wrongly kept boxes are filled, so they read among the rest.
+    const Vec3 colours[] = {Vec3(0.12f), Vec3(0.12f), Vec3(0.1f, 0.75f, 0.15f),
+                            Vec3(1.0f, 0.08f, 0.05f)};
     // Boxes at the level, drawn culled first so kept and wrongly kept stay on top.
     std::vector<std::pair<uint32_t, int>> stack = {{0, 0}}, drawn;
     while (!stack.empty()) {
@@ -78,6 +215,7 @@ void drawCullingMap(Image& image, int x0, int width, const Bvh& bvh, const Frust
         stack.push_back({node.leftFirst, depth + 1});
         stack.push_back({node.leftFirst + 1, depth + 1});
     }
+    int thickness = std::min(width, image.height()) >= 250 ? 2 : 1;
     std::stable_sort(drawn.begin(), drawn.end(),
                      [](const auto& a, const auto& b) { return a.second < b.second; });
     for (auto [index, kind] : drawn) {
@@ -92,18 +230,23 @@ void drawCullingMap(Image& image, int x0, int width, const Bvh& bvh, const Frust
             hi = glm::max(hi, m);
         }
         Vec3 c = colours[kind];
-        line(image, x0, width, lo, Vec2(hi.x, lo.y), c);
-        line(image, x0, width, Vec2(hi.x, lo.y), hi, c);
-        line(image, x0, width, hi, Vec2(lo.x, hi.y), c);
-        line(image, x0, width, Vec2(lo.x, hi.y), lo, c);
+        if (kind == int(NodeVisibility::WronglyKept)) fillRect(image, x0, width, lo, hi, c, 0.2f);
+        int t = kind == int(NodeVisibility::WronglyKept) ? thickness : 1;
+        line(image, x0, width, lo, Vec2(hi.x, lo.y), c, t);
+        line(image, x0, width, Vec2(hi.x, lo.y), hi, c, t);
+        line(image, x0, width, hi, Vec2(lo.x, hi.y), c, t);
+        line(image, x0, width, Vec2(lo.x, hi.y), lo, c, t);
     }
-    // The frustum's twelve edges, in light blue.
+    // The frustum's twelve edges, in light blue; on larger maps they and the wrongly kept
+    // boxes are two pixels wide.
     const auto& k = frustum.corners;
     const int edges[12][2] = {{0, 1}, {1, 3}, {3, 2}, {2, 0}, {4, 5}, {5, 7},
                               {7, 6}, {6, 4}, {0, 4}, {1, 5}, {2, 6}, {3, 7}};
+    const Vec3 frustumColour(0.25f, 0.55f, 1.0f);
     for (const auto& e : edges)
-        line(image, x0, width, toMap(k[size_t(e[0])]), toMap(k[size_t(e[1])]),
-             Vec3(0.4f, 0.7f, 1.0f));
+        line(image, x0, width, toMap(k[size_t(e[0])]), toMap(k[size_t(e[1])]), frustumColour,
+             thickness);
+    drawLegend(image, x0, width, colours, frustumColour);
 }
 
 void addCullingMap(Report& report, const Bvh& bvh, const std::string& png, int width, int height,
@@ -115,8 +258,9 @@ void addCullingMap(Report& report, const Bvh& bvh, const std::string& png, int w
     std::string path = pngWithSuffix(png, "-cull");
     map.writePng(path);
     report.images.push_back({path,
-                             "the hierarchy from above (depth 6): grey culled, green kept, red "
-                             "wrongly kept by the plane test; the frustum in blue"});
+                             "the hierarchy from above (depth 6) coloured by the plane test, and "
+                             "a camera's frustum; a red box over the frustum's tinted footprint "
+                             "passes above or below it"});
 }
 
 std::vector<KeyBinding> CullingMapWindow::keys() {

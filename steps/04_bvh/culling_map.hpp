@@ -1,6 +1,6 @@
 // Step 04: the hierarchy seen from above, its boxes coloured by the culling test of a
-// camera's frustum (grey culled, green kept, red wrongly kept): the window's right half
-// and the headless run's -cull.png. Culled boxes are outside the image by definition,
+// camera's frustum (grey culled, green kept, red wrongly kept, with a legend in the
+// picture): the window's right half and the headless run's -cull.png. Culled boxes are outside the image by definition,
 // hence a map rather than outlines over the rendered view.
 #pragma once
 

@@ -261,7 +261,7 @@ Table measureCulling(const NamedMesh& mesh, const Bvh& bvh, int cameras) {
             cullHierarchy(bvh, f, test, &c);
             Timing time = measure(5, [&] { cullHierarchy(bvh, f, test); });
             t.row({(long long)i,
-                   std::string(test == CullTest::Planes ? "planes" : "planes+corners"),
+                   std::string(test == CullTest::Planes ? "planes" : "+ corners"),
                    (long long)c.visited, (long long)c.culled, (long long)c.kept,
                    (long long)c.wronglyKept, (long long)c.keptTriangles, time.median * 1e3,
                    time.min * 1e3, time.max * 1e3});

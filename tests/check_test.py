@@ -169,7 +169,7 @@ def case_watch(kit, exercise, correct_text, poll):
         t, i = wait_for(r"^\[check\] watching steps/", 0, 600)
         first = "\n".join(l for _, l in lines[:i])
         check(t is not None and "failed" in row(first, exercise.id), f"watch ({how}): the first run shows {exercise.id} failing")
-        time.sleep(1.0)  # a save a moment after the run, as a student's
+        time.sleep(1.3)  # a save a moment after the run (not in step with a 0.5 s poll)
         saved = time.monotonic()
         with open(os.path.join(kit, exercise.path), "w", encoding="utf-8") as f:
             f.write(correct_text)

@@ -8,8 +8,9 @@ As root, with a root-owned file already at every fixed /tmp path the workbook on
 (FIXED_PATHS), it creates two unprivileged users, gives each a fresh clone of this tree in
 their home, configures it once (-O1, as the grader builds), then runs COMMANDS as both users
 at the same time (setpriv, a clean environment): the tour of one step and that step's tests
-(both users), and grading the clone (the first user). Every command must succeed, and after
-each one the user owns nothing new in /tmp, /var/tmp or /dev/shm. Then, with stand-ins for dpkg-query and npm on
+(both users), then grading the clone (the first user) while the second writes a starter kit
+and runs the kit's check of that step. Every command must succeed, and after each one the
+user owns nothing new in /tmp, /var/tmp or /dev/shm. Then, with stand-ins for dpkg-query and npm on
 PATH (no network, no install): a missing package names what the administrator runs once;
 npm's log goes nowhere shared (the old /tmp log broke the second user); a failing npm shows
 its output; Ctrl-C during npm leaves nothing behind. The users and their homes are removed
@@ -18,6 +19,7 @@ at the end.
 import hashlib
 import os
 import pwd
+import re
 import resource
 import shutil
 import signal
@@ -37,13 +39,27 @@ STEP = "01"
 FIXED_PATHS = ["/tmp/boxes-apt.log", "/tmp/boxes-npm.log"]
 SHARED_TEMP = ["/tmp", "/var/tmp", "/dev/shm"]
 GRADING = os.path.exists(os.path.join(ROOT, "tools", "grading", "grade.py"))  # not in a kit
-# What the users run, in order, in their clones: (name, command, both). One line per command.
-# both: the two users at once; the grader's build is a second build of the core, so one user
-# grades (while the other still builds and tests) to keep the test cheap on two cores.
+KIT = "kit"  # the starter kit the second user writes beside their clone, in their home
+# -O1, as the grader builds: the users' builds cost less, and what is tested is the same.
+# Where ccache is installed, each user's clone and kit build through a cache of that user's
+# own, in their home (removed with it): the kit's core and tests are the clone's, so its
+# build recompiles only the kit's stubs.
+CCACHE = shutil.which("ccache")
+CONFIGURE = (["cmake", "--preset", "release", "-DCMAKE_CXX_FLAGS_RELEASE=-O1 -DNDEBUG"]
+             + ([f"-DCMAKE_CXX_COMPILER_LAUNCHER={CCACHE}", f"-DCMAKE_C_COMPILER_LAUNCHER={CCACHE}"]
+                if CCACHE else []))
+# What the users run, in order: (name, command, who, where). One line per command. who:
+# "both" at once, or the first or the second user alone; where: the clone, or the kit.
+# The grader's build and the kit's are a second build of the core each: the first user
+# grades while the second writes a starter kit and runs its check of one step, so the two
+# builds share the two cores.
 COMMANDS = [
-    ("tour", ["./workbook", "tour", "--steps", STEP], True),
-    ("test", ["./workbook", "test", "--steps", STEP], True),
-] + ([("grade", ["./workbook", "grade", ".", "--steps", STEP, "--timeout", "20"], False)] if GRADING else [])
+    ("tour", ["./workbook", "tour", "--steps", STEP], "both", "clone"),
+    ("test", ["./workbook", "test", "--steps", STEP], "both", "clone"),
+] + ([("grade", ["./workbook", "grade", ".", "--steps", STEP, "--timeout", "20"], "first", "clone"),
+      ("kit", ["./workbook", "kit", os.path.join("..", KIT), "--no-pictures"], "second", "clone"),
+      ("configure the kit", CONFIGURE, "second", "kit"),
+      ("check", ["./workbook", "check", STEP], "second", "kit")] if GRADING else [])
 
 failures = []
 lock = threading.Lock()
@@ -113,11 +129,15 @@ class User:
         self.pw = pwd.getpwnam(name)
         self.name, self.home = name, self.pw.pw_dir
         self.clone = os.path.join(self.home, "boxes")
+        self.kit = os.path.join(self.home, KIT)
 
     def env(self, **extra):
         """A login's plain environment: no TMPDIR, nothing of this test's."""
         env = dict(PATH="/usr/local/bin:/usr/bin:/bin", HOME=self.home, USER=self.name,
                    LOGNAME=self.name, LANG="C.UTF-8")
+        if CCACHE:  # the user's own cache; paths under the home relative, so clone and kit share it
+            env.update(CCACHE_DIR=os.path.join(self.home, ".ccache"), CCACHE_BASEDIR=self.home,
+                       CCACHE_NOHASHDIR="1", CCACHE_TEMPDIR=os.path.join(self.home, ".ccache", "tmp"))
         env.update(extra)
         return env
 
@@ -127,8 +147,8 @@ class User:
                                 stdout=subprocess.PIPE, stderr=subprocess.STDOUT, text=True,
                                 start_new_session=True)
 
-    def run(self, cmd, timeout=900, **extra):
-        p = self.popen(cmd, **extra)
+    def run(self, cmd, timeout=900, cwd=None, **extra):
+        p = self.popen(cmd, cwd=cwd, **extra)
         try:
             out, _ = p.communicate(timeout=timeout)
         except subprocess.TimeoutExpired:
@@ -153,17 +173,17 @@ def tail(text, n=30):
 
 
 def scenario(user, first):
-    """Configure once, then COMMANDS in order (the first user all of them, the other those
-    both run); each succeeds and leaves nothing in /tmp."""
+    """Configure once, then COMMANDS in order (those of both users and this user's own);
+    each succeeds and leaves nothing in /tmp."""
     before = owned_in_temp(user.pw.pw_uid)
     check(not before, f"{user.name}: owns nothing in {', '.join(SHARED_TEMP)} before: {sorted(before)}")
-    rc, out = user.run(["cmake", "--preset", "release", "-DCMAKE_CXX_FLAGS_RELEASE=-O1 -DNDEBUG"])
+    rc, out = user.run(CONFIGURE)
     check(rc == 0, f"{user.name}: configures its clone ({tail(out, 5)})")
-    for name, cmd, both in COMMANDS:
-        if not (first or both):
+    for name, cmd, who, where in COMMANDS:
+        if who != "both" and (who == "first") != first:
             continue
         started = time.monotonic()
-        rc, out = user.run(cmd)
+        rc, out = user.run(cmd, cwd=user.kit if where == "kit" else user.clone)
         left = owned_in_temp(user.pw.pw_uid) - before
         seconds = time.monotonic() - started
         if rc != 0:
@@ -173,6 +193,10 @@ def scenario(user, first):
         if name == "tour":
             check(os.path.exists(os.path.join(user.clone, "out", "index.html")),
                   f"{user.name}: the tour wrote out/index.html in its clone")
+        if name == "check":
+            check(re.search(r"^  total\s+0/\d+\s+points", out, re.M) is not None and
+                  f"Next: exercise {int(STEP)}.1:" in out,
+                  f"{user.name}: the kit's check of step {STEP}: 0 points, exercise {int(STEP)}.1 next")
 
 
 def write_script(path, text, owner):

@@ -374,6 +374,28 @@ TEST_SUITE("exercise 5.6") {
         }
         CHECK(hits > 1500);
     }
+    TEST_CASE("reciprocal slab test: a NaN slab leaves the entry distance of the others alone") {
+        // An origin on a slab plane with a zero direction component: (0 - 0) * inf = NaN.
+        // std::max(tNear, t0) would take the NaN and lose the other slabs' entry.
+        test::FpTrapsOff nanOnPurpose;
+        // The NaN slab (z) last: x enters at t = 1, the NaN must not be returned.
+        Bounds3f cube(Vec3(0), Vec3(1));
+        Ray last(Vec3(-1, 0.5f, 0), Vec3(1, 0, 0));
+        auto a = slabReciprocal(precomputeRay(last), cube);
+        REQUIRE(a.has_value());
+        CHECK(*a == 1.0f);
+        // The NaN slab (y) between x, which enters at t = 2, and z, which enters at 0.5:
+        // the entry is 2, the later of the two.
+        Bounds3f tall(Vec3(0), Vec3(1, 1, 4));
+        for (float zero : {0.0f, -0.0f}) {
+            Ray middle(Vec3(-2, 0, -0.5f), Vec3(1, zero, 1));
+            auto b = slabReciprocal(precomputeRay(middle), tall);
+            INFO("y direction " << zero);
+            REQUIRE(b.has_value());
+            CHECK(*b == 2.0f);
+            CHECK(slabDivision(middle, tall) == b);
+        }
+    }
     TEST_CASE("hard case: zero direction components with -0.0 and an origin on a slab") {
         Bounds3f box(Vec3(0), Vec3(1));
         test::FpTrapsOff nanOnPurpose;  // the origin on a slab plane: 0 * inf = NaN by design
@@ -423,6 +445,23 @@ TEST_SUITE("exercise 5.7") {
             }
         }
         CHECK(hits > 1000);
+        // An edge that a + (c - a) does not give back: c.x - a.x = 1 + 2^-24 is a tie and
+        // rounds to 1, and 2^-24 + 1 rounds to 1 again, so (a + e2) - a = 1 - 2^-24. Edges
+        // recomputed from the vertices in another order are not the stored ones.
+        const float a = std::ldexp(1.0f, -24), c = 1.0f + std::ldexp(1.0f, -23);
+        REQUIRE((a + (c - a)) - a != c - a);
+        TriangleVertices tie{Vec3(a, 0, 0), Vec3(0, 1, 0), Vec3(c, 0, 0)};
+        for (Vec3 o : {Vec3(0.25f, 0.25f, 1), Vec3(0.5f, 0.125f, 2), Vec3(0.1f, 0.7f, 3)}) {
+            Ray ray(o, Vec3(0.01f, -0.02f, -1));
+            auto x = intersectFromVertices(ray, tie);
+            auto y = intersectPrecomputed(ray, precomputeTriangle(tie));
+            INFO("origin " << o);
+            REQUIRE(x.has_value());
+            REQUIRE(y.has_value());
+            CHECK(x->t == y->t);
+            CHECK(x->u == y->u);
+            CHECK(x->v == y->v);
+        }
     }
 }
 
@@ -506,6 +545,11 @@ TEST_SUITE("exercise 5.9") {
             4, 3, [&](Image&, int) { f.now += f.cost; }, f.clock());
         CHECK(r.advance(15 * kMs) == 1);
         CHECK(r.linesDone() == 1);
+        // Every later frame too, once the last line's cost (20 ms) predicts an overrun.
+        CHECK(r.advance(15 * kMs) == 1);
+        CHECK(r.advance(15 * kMs) == 1);
+        CHECK(r.linesDone() == 3);
+        CHECK(r.complete());
     }
     TEST_CASE("incremental renderer: the completed image equals the direct render bit for bit") {
         Scene scene = makeScene("spheres", {});

@@ -184,6 +184,15 @@ TEST_SUITE("exercise 6.3") {
         checkVec(out.vertices[3].position, Vec4d(0.5, 0, -1, 1), 1e-15);
         checkVec(out.vertices[3].weights, glm::dvec3(0.5, 0, 0.5), 1e-15);
         CHECK(out.vertices[3].position.w == 1.0);
+        // Unequal distances, a 2 outside and b and c 1 inside: each crossing a third of the
+        // way from its inside end, t = dIn / (dIn - dOut) = 1 / 3.
+        ClipPolygon far =
+            clipAgainstPlane(triangle({0, 0, -3, 1}, {0, 0, 0, 1}, {1, 0, 0, 1}), kClipNearPlane);
+        REQUIRE(far.count == 4);
+        checkVec(far.vertices[0].position, Vec4d(0, 0, -1, 1), 1e-15);
+        checkVec(far.vertices[0].weights, glm::dvec3(1.0 / 3.0, 2.0 / 3.0, 0), 1e-15);
+        checkVec(far.vertices[3].position, Vec4d(2.0 / 3.0, 0, -1, 1), 1e-15);
+        checkVec(far.vertices[3].weights, glm::dvec3(1.0 / 3.0, 0, 2.0 / 3.0), 1e-15);
     }
     TEST_CASE("clipping: the new vertices carry interpolated weights") {
         // a inside (z + w = 1), b outside (z + w = -3): the crossing a quarter of the way.
@@ -295,6 +304,13 @@ TEST_SUITE("exercise 6.5") {
             }
         // The top and left sides belong to the square, the bottom and right do not: 8 x 8.
         CHECK(covered == 64);
+        for (int k = 1; k <= 8; ++k) {
+            INFO("row or column " << k);
+            CHECK(counts[size_t(k * w + 1)] == 1);  // on the left side
+            CHECK(counts[size_t(1 * w + k)] == 1);  // on the top side
+            CHECK(counts[size_t(k * w + 9)] == 0);  // on the right side
+            CHECK(counts[size_t(9 * w + k)] == 0);  // on the bottom side
+        }
     }
     TEST_CASE("a fan of triangles around one vertex: every covered pixel exactly once") {
         const int w = 24, h = 24;
@@ -444,8 +460,22 @@ TEST_SUITE("exercise 6.9") {
         // A point on a floor plane does not shadow itself (the origin is offset).
         s.planes.push_back({{Vec3(0, 1, 0), 0.0f}, 0});
         CHECK(litByShadowRay(s, Vec3(3, 0, 0), Vec3(0, 1, 0), light));
-        // The light beyond the sphere only counts up to the light: a sphere behind it does not.
+        // Between the sphere and the light: the sphere behind the point does not shadow it.
         CHECK(litByShadowRay(s, Vec3(0, 7, 0), Vec3(0, 1, 0), light));
+    }
+    TEST_CASE("hybrid shadow ray: an occluder beyond the light does not shadow the point") {
+        // The light at y = 10, spheres above it (the nearest surface at y = 10.5): a shadow
+        // ray that does not stop at the light hits them.
+        Scene s;
+        s.lights.push_back({Vec3(0, 10, 0), Vec3(100.0f), kInfinity<float>});
+        s.spheres.push_back({{Vec3(0, 11.5f, 0), 1.0f}, 0});
+        s.spheres.push_back({{Vec3(3, 40, 0), 5.0f}, 0});
+        const PointLight& light = s.lights[0];
+        CHECK(litByShadowRay(s, Vec3(0, 0, 0), Vec3(0, 1, 0), light));
+        CHECK(litByShadowRay(s, Vec3(-0.3f, 1, 0), Vec3(0, 1, 0), light));
+        // The same sphere between the point and the light does shadow it.
+        s.spheres.push_back({{Vec3(0, 5, 0), 1.0f}, 0});
+        CHECK_FALSE(litByShadowRay(s, Vec3(0, 0, 0), Vec3(0, 1, 0), light));
     }
 }
 

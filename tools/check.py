@@ -198,8 +198,10 @@ def first_failure(case):
             "file": "", "line": ""}
 
 
-def classify(exercise_id, cases):
-    """(status, the first failing case or None) for one exercise's test cases."""
+def classify(exercise_id, cases, mistakes=None):
+    """(status, the failing case to show or None) for one exercise's test cases: the first
+    failing case, or the first that exists for a catalogued mistake of this exercise
+    (`mistakes`: tests/hints/mistakes.json), whose hint says more than the exercise's."""
     if not cases:
         return "no tests", None
     failing = [c for c in cases if not c["passed"]]
@@ -214,7 +216,8 @@ def classify(exercise_id, cases):
         return "not started", failing[missing.index(exercise_id)]
     real = [c for c, m in zip(failing, missing) if m is None]
     if real:
-        return "failed", real[0]
+        own = [c for c in real if (mistakes or {}).get(c["name"], {}).get("exercise") == exercise_id]
+        return "failed", (own or real)[0]
     return "needs " + ", ".join(sorted(set(missing), key=lambda s: tuple(map(int, s.split("."))))), failing[0]
 
 
@@ -254,6 +257,7 @@ def hint_for(row, hints):
 
 def check_once(root, chosen, opts):
     rows, built = [], {}
+    mistakes = load_hints(root)[1]
     problem = configure(root)
     for e in chosen:
         row = {"id": e.id, "title": e.title, "points": e.points, "earned": 0, "step": e.step,
@@ -281,7 +285,7 @@ def check_once(root, chosen, opts):
         if cases is None:
             row["status"], row["detail"] = "crashed", "no test results were written"
             continue
-        row["status"], row["case"] = classify(e.id, cases)
+        row["status"], row["case"] = classify(e.id, cases, mistakes)
         row["cases"], row["failed"] = len(cases), sum(not c["passed"] for c in cases)
         if row["status"] == "passed":
             row["earned"] = e.points

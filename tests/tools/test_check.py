@@ -53,6 +53,17 @@ class Classify(unittest.TestCase):
         self.assertEqual(first["failure"]["expression"], "!hit.has_value()")
         self.assertEqual(first["failure"]["infos"], ["ray O (0, 0, -1) D (0.9, 0.9, 1)"])
 
+    def test_a_failing_case_of_a_catalogued_mistake_is_shown_first(self):
+        cases = check.parse_cases(xml(case("worked hits", 1, FAILED_CHECK),
+                                      case("past the third edge", 1, FAILED_CHECK)))
+        mistakes = {"past the third edge": {"exercise": "1.4", "hint": "check u + v"},
+                    "worked hits": {"exercise": "1.3", "hint": "another exercise's"}}
+        self.assertEqual(check.classify("1.4", cases)[1]["name"], "worked hits")
+        status, shown = check.classify("1.4", cases, mistakes)
+        self.assertEqual((status, shown["name"]), ("failed", "past the third edge"))
+        self.assertEqual(check.hint_for({"id": "1.4", "case": shown}, ({}, mistakes)),
+                         ("check u + v", True))
+
     def test_no_cases_is_no_tests(self):
         self.assertEqual(check.classify("1.4", [])[0], "no tests")
 

@@ -1,0 +1,229 @@
+#!/usr/bin/python3
+"""The student's loop end to end (ctest label "grading"): `./workbook check` in a fresh
+starter kit, as a student uses it.
+
+usage: tests/check_test.py WORK_DIR [BUILD_DIR]
+  BUILD_DIR: this tree's release build, whose step 01 program renders the kit's reference
+  pictures (default build/release)
+
+One kit, one build of step 01 in it, the cases in order:
+  fresh        `check 01`: 0 points, every exercise "not started", the next one is 1.1 with
+               its file and line (the line of its EXERCISE marker)
+  correct 1.4  the reference's 1.4 copied into the kit: `check 1.4` passes, and its picture
+               is the reference's
+  wrong 1.4    the catalogued mistake without the u + v > 1 rejection: `check 1.4` fails,
+               names the mistake's test case, `--hint` gives the mistake's hint, and
+               out/check/1.4.png marks the extra pixels (as many as it says)
+  watch        `check 1.4 --watch`: an edit (the mistake fixed) starts a new run within two
+               seconds, and that run passes; by polling too when inotifywait is installed
+
+Only step 01 is built (check builds the steps it checks), so the kit costs one build of the
+core and step 01, at -O1 as the grader builds. The kit is written anew each run (a fresh
+kit), in WORK_DIR/kit.
+"""
+import os
+import re
+import shutil
+import signal
+import subprocess
+import sys
+import threading
+import time
+
+ROOT = os.path.dirname(os.path.dirname(os.path.abspath(__file__)))
+sys.path.insert(0, ROOT)  # the tools package, imported from the repository root
+from tools import png  # noqa: E402
+from tools.grading.exercises import exercises  # noqa: E402
+from tools.grading.kit import strip_solutions, write_kit  # noqa: E402
+from tools.grading.mutants import git_apply, read_mutant  # noqa: E402
+from tools import pictures  # noqa: E402
+from tools.pictures import HEIGHT, MARK, WIDTH, render_references  # noqa: E402
+
+EXERCISE = "1.4"
+MISTAKE = os.path.join(ROOT, "tests", "mutants", "1.4-no-uv-sum-rejection.patch")
+WATCH_LIMIT = 2.0  # seconds from a save to the new run
+
+failures = []
+
+
+def check(condition, message):
+    print(("ok    " if condition else "FAIL  ") + message, flush=True)
+    if not condition:
+        failures.append(message)
+
+
+def run_check(kit, *args):
+    """./workbook check ARGS in the kit: (exit code, output)."""
+    started = time.monotonic()
+    r = subprocess.run(["./workbook", "check", *args], cwd=kit, capture_output=True, text=True,
+                       timeout=900)
+    out = r.stdout + r.stderr
+    print(f"--- ./workbook check {' '.join(args)}: exit {r.returncode}, "
+          f"{time.monotonic() - started:.1f} s\n{out}", flush=True)
+    return r.returncode, out
+
+
+def row(out, exercise_id):
+    """The table's line of one exercise, or ""."""
+    m = re.search(rf"^  {re.escape(exercise_id)}\s+\d+/\d+\s+.*$", out, re.M)
+    return m.group(0) if m else ""
+
+
+def solve(kit, exercise):
+    """The kit's file of the exercise with the reference's solution of that exercise only."""
+    path = os.path.join(ROOT, exercise.path)
+    with open(path, encoding="utf-8") as f:
+        text, _ = strip_solutions(f.read(), path, ROOT, keep={exercise.id})
+    with open(os.path.join(kit, exercise.path), "w", encoding="utf-8") as f:
+        f.write(text)
+    return text
+
+
+def marked(composite):
+    """Magenta pixels in the third panel of check's picture (yours | reference | difference)."""
+    w, h, rows = png.read(composite)
+    gap = (w - 3 * WIDTH) // 2
+    start = 2 * (WIDTH + gap)
+    mark = bytes(MARK)
+    return (w, h), sum(row[3 * x : 3 * x + 3] == mark for row in rows
+                       for x in range(start, start + WIDTH))
+
+
+def case_fresh(kit, ex):
+    step = [e for e in ex if e.step == 1]
+    rc, out = run_check(kit, "01")
+    check(rc == 0, f"fresh kit: check 01 exits 0 (nothing attempted), exit {rc}")
+    total = sum(e.points for e in step)
+    check(re.search(rf"^  total\s+0/{total}\s+points", out, re.M) is not None, f"fresh kit: 0 of {total} points")
+    check(all("not started" in row(out, e.id) for e in step), "fresh kit: every exercise of step 01 is not started")
+    first = step[0]
+    check(f"Next: exercise {first.id}:" in out, f"fresh kit: the next exercise is {first.id}")
+    m = re.search(r"^  where: (\S+):(\d+)$", out, re.M)
+    where_ok = False
+    if m and os.path.isfile(os.path.join(kit, m.group(1))):
+        with open(os.path.join(kit, m.group(1)), encoding="utf-8") as f:
+            lines = f.read().split("\n")
+        n = int(m.group(2))
+        where_ok = 1 <= n <= len(lines) and f"EXERCISE {first.id}:" in lines[n - 1]
+    check(where_ok, f"fresh kit: the file and line given hold exercise {first.id}'s marker ({m and m.group(0).strip()})")
+
+
+def case_correct(kit, exercise):
+    solve(kit, exercise)
+    rc, out = run_check(kit, exercise.id)
+    check(rc == 0 and "passed" in row(out, exercise.id), f"correct {exercise.id}: check {exercise.id} passes")
+    pic = os.path.join(kit, "out", "check", f"{exercise.id}.png")
+    check(os.path.isfile(pic) and marked(pic) == ((3 * WIDTH + 8, HEIGHT), 0),
+          f"correct {exercise.id}: out/check/{exercise.id}.png has no pixel marked")
+
+
+def case_wrong(kit, exercise):
+    mutant = read_mutant(MISTAKE)
+    r = git_apply(kit, MISTAKE)
+    check(r.returncode == 0, f"wrong {exercise.id}: the mistake applies to the kit ({r.stderr.strip()})")
+    rc, out = run_check(kit, exercise.id, "--hint")
+    check(rc == 1 and "failed" in row(out, exercise.id), f"wrong {exercise.id}: check {exercise.id} fails, exit {rc}")
+    check(f'failing test case: "{mutant.caught_by}"' in out,
+          f"wrong {exercise.id}: the failing case named is the mistake's: {mutant.caught_by!r}")
+    check("the check " in out and "failed at tests/" in out, f"wrong {exercise.id}: the failing check and its line")
+    check("hint (this mistake): " in out, f"wrong {exercise.id}: --hint gives the mistake's own hint")
+    m = re.search(r"(\d+) of (\d+) pixels differ from the reference", out)
+    said = int(m.group(1)) if m else 0
+    pic = os.path.join(kit, "out", "check", f"{exercise.id}.png")
+    size, count = marked(pic) if os.path.isfile(pic) else (None, -1)
+    check(said > 0 and count == said,
+          f"wrong {exercise.id}: out/check/{exercise.id}.png marks the extra pixels ({count} marked, {said} said)")
+
+
+def case_watch(kit, exercise, correct_text, poll):
+    """--watch with the mistake in place: saving the correct file starts a new run within
+    WATCH_LIMIT seconds, which passes."""
+    how = "polling" if poll else "inotifywait" if shutil.which("inotifywait") else "polling (no inotifywait)"
+    # The module itself: ./workbook would first install inotify-tools when missing and root.
+    cmd = [sys.executable, "-m", "tools.check", exercise.id, "--watch", "--no-pictures"] + (["--poll"] if poll else [])
+    p = subprocess.Popen(cmd, cwd=kit, stdout=subprocess.PIPE, stderr=subprocess.STDOUT, text=True,
+                         start_new_session=True)
+    lines, events = [], []
+    cond = threading.Condition()
+
+    def reader():
+        for line in p.stdout:
+            with cond:
+                lines.append((time.monotonic(), line.rstrip("\n")))
+                cond.notify_all()
+
+    def wait_for(pattern, after, timeout):
+        deadline = time.monotonic() + timeout
+        with cond:
+            while True:
+                for t, line in lines[after:]:
+                    if re.search(pattern, line):
+                        return t, lines.index((t, line))
+                left = deadline - time.monotonic()
+                if left <= 0 or p.poll() is not None and not any(re.search(pattern, l) for _, l in lines[after:]):
+                    return None, len(lines)
+                cond.wait(min(left, 0.2))
+
+    threading.Thread(target=reader, daemon=True).start()
+    try:
+        t, i = wait_for(r"^\[check\] watching steps/", 0, 600)
+        first = "\n".join(l for _, l in lines[:i])
+        check(t is not None and "failed" in row(first, exercise.id), f"watch ({how}): the first run shows {exercise.id} failing")
+        time.sleep(1.3)  # a save a moment after the run (not in step with a 0.5 s poll)
+        saved = time.monotonic()
+        with open(os.path.join(kit, exercise.path), "w", encoding="utf-8") as f:
+            f.write(correct_text)
+        t, j = wait_for(r"changed: checking again", i, 30)
+        delay = (t - saved) if t is not None else None
+        check(delay is not None and delay <= WATCH_LIMIT,
+              f"watch ({how}): the save starts a new run within {WATCH_LIMIT:g} s "
+              f"({'none' if delay is None else f'{delay:.2f} s'})")
+        t2, k = wait_for(r"^\[check\] watching steps/", j, 600)
+        second = "\n".join(l for _, l in lines[j:k])
+        check(t2 is not None and "passed" in row(second, exercise.id),
+              f"watch ({how}): the new run checks the saved code: {exercise.id} passes")
+    finally:
+        os.killpg(p.pid, signal.SIGKILL)
+        p.wait()
+        print("\n".join(l for _, l in lines[-40:]), flush=True)
+
+
+def main():
+    if len(sys.argv) not in (2, 3):
+        print(__doc__, file=sys.stderr)
+        return 2
+    work = os.path.abspath(sys.argv[1])
+    build = os.path.abspath(sys.argv[2]) if len(sys.argv) == 3 else os.path.join(ROOT, "build", "release")
+    started = time.monotonic()
+    kit = os.path.join(work, "kit")
+    shutil.rmtree(kit, ignore_errors=True)
+    os.makedirs(work, exist_ok=True)
+    write_kit(kit, ROOT)
+    # This build's step 01 program, built when it is not (ctest runs after the build).
+    program = pictures.program(ROOT, build, 1)[0]
+    render_references(kit, ROOT, steps={1}, build=build, log=print,
+                      build_programs=not os.path.exists(program))
+    print(f"kit written with step 01's reference pictures: {time.monotonic() - started:.1f} s", flush=True)
+    ex = exercises(ROOT)
+    exercise = next(e for e in ex if e.id == EXERCISE)
+    # -O1, as the grader builds: a cheaper build of the same code (no -ffast-math, so the
+    # pictures are the same); check configures a kit that has no build itself.
+    r = subprocess.run(["cmake", "--preset", "release", "-DCMAKE_CXX_FLAGS_RELEASE=-O1 -DNDEBUG"],
+                       cwd=kit, capture_output=True, text=True)
+    check(r.returncode == 0, f"the kit configures ({r.stderr.strip()[-300:]})")
+    case_fresh(kit, ex)
+    case_correct(kit, exercise)
+    with open(os.path.join(kit, exercise.path), encoding="utf-8") as f:
+        correct_text = f.read()
+    case_wrong(kit, exercise)
+    case_watch(kit, exercise, correct_text, poll=False)
+    if shutil.which("inotifywait"):
+        git_apply(kit, MISTAKE)
+        case_watch(kit, exercise, correct_text, poll=True)
+    print(f"{time.monotonic() - started:.1f} s in all", flush=True)
+    print(f"{len(failures)} failed" if failures else "all checks passed")
+    return 1 if failures else 0
+
+
+if __name__ == "__main__":
+    sys.exit(main())

@@ -8,6 +8,7 @@
 #include <vector>
 
 #include "04_bvh/trace.hpp"
+#include "core/camera.hpp"
 
 namespace boxes {
 
@@ -42,5 +43,9 @@ std::vector<TraceHit> readHits(const std::string& path);
 enum class RayKind { Primary, Diffuse, Random };
 const char* rayKindName(RayKind kind);
 std::vector<Ray> makeRays(const Mesh& mesh, RayKind kind, size_t count, uint64_t seed);
+// Primary rays of a given camera (its aspect ignored): a square image of round(sqrt(count))
+// pixels a side, row 0 at the top, pixel centres, repeated from the top when count is not a
+// square. The `rays` command uses it for a camera inside a scene.
+std::vector<Ray> makeCameraRays(const Camera& camera, size_t count);
 
 }  // namespace boxes

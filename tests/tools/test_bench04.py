@@ -1,36 +1,36 @@
-"""Unit tests of tools/bench/bench04.py: the folders it needs from outside the workbook, the
-rounds' ratios and the agreement of hits."""
+"""Unit tests of tools/bench/bench04.py and meshes.py: the motorbike's conversion, the meshes
+that cannot be had, the rounds' ratios and the agreement of hits."""
 import os
 import struct
 import sys
 import tempfile
 import unittest
-from unittest import mock
 import scratch  # noqa: F401  (tempfile's folders: one, removed at exit)
 
 sys.path.insert(0, os.path.dirname(os.path.dirname(os.path.dirname(os.path.abspath(__file__)))))
-from tools.bench import bench04  # noqa: E402
+from tools.bench import bench04, meshes  # noqa: E402
 
 
-class OutsidePaths(unittest.TestCase):
-    def test_flags_first_then_the_variables(self):
-        a, b = tempfile.mkdtemp(), tempfile.mkdtemp()
-        with mock.patch.dict(os.environ, {"BOXES_MESHES": b, "BOXES_PEER_BENCH": b}):
-            self.assertEqual(bench04.outside_paths(a, None), (a, b))
-            self.assertEqual(bench04.outside_paths(None, a), (b, a))
+class Meshes(unittest.TestCase):
+    def test_the_motorbike_conversion_drops_repeated_triangles_and_keeps_the_order(self):
+        lines = ["# comment", "g one", "v 0 0 0", "v 1.5e-08 0 0", "v 0 1 0", "v 0 0 1",
+                 "f 1 2 3", "f 2/7/1 4/7/1 3/7/1", "g two", "f 3 1 2", "f 1 2 3 4", "f -1 -2 -3"]
+        text, counts = meshes.convert_motorbike(lines)
+        # f 3 1 2 repeats 1 2 3 (any order); the quad's fans are 1 2 3 (a repeat) and 1 3 4;
+        # -1 -2 -3 is 4 3 2, a repeat of 2 4 3.
+        self.assertEqual(text, "v 0 0 0\nv 1.5e-08 0 0\nv 0 1 0\nv 0 0 1\n"
+                               "f 1 2 3\nf 2 4 3\nf 1 3 4\n")
+        self.assertEqual(counts, {"vertices": 4, "triangles": 3, "dropped": 3})
 
-    def test_a_missing_one_is_named_with_its_flag_and_variable(self):
-        with mock.patch.dict(os.environ, {}, clear=True):
-            with self.assertRaises(SystemExit) as e:
-                bench04.outside_paths(None, tempfile.mkdtemp())
-            self.assertEqual(str(e.exception), "bench04: the meshes folder (MESH.obj for every --meshes name) "
-                                               "is not given: pass --data DIR or set BOXES_MESHES")
-            with self.assertRaises(SystemExit) as e:
-                bench04.outside_paths(tempfile.mkdtemp(), None)
-            self.assertIn("pass --peer-dir DIR or set BOXES_PEER_BENCH", str(e.exception))
-            with self.assertRaises(SystemExit) as e:
-                bench04.outside_paths("/nonexistent/meshes", tempfile.mkdtemp())
-            self.assertEqual(str(e.exception), "bench04: --data / BOXES_MESHES /nonexistent/meshes: no such folder")
+    def test_a_mesh_that_cannot_be_had_says_why(self):
+        with self.assertRaises(meshes.Unavailable) as e:
+            meshes.mesh_path("oa_thor", tempfile.mkdtemp())
+        self.assertIn("openarena-088-data", str(e.exception))
+        folder = tempfile.mkdtemp()
+        with self.assertRaises(meshes.Unavailable) as e:
+            meshes.mesh_path("bunny", tempfile.mkdtemp(), folder)
+        self.assertEqual(str(e.exception), "bunny: no %s" % os.path.join(folder, "bunny.obj"))
+        self.assertTrue(os.path.exists(meshes.mesh_path("bunny", folder)))
 
 
 class Ratios(unittest.TestCase):

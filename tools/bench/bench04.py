@@ -305,7 +305,7 @@ def bench(a, work):
                 if not sah:
                     continue
                 sah = sah[0]
-                quality.append({"mesh": mesh, "tris": sah["tris"], "bins": sah["bins"],
+                quality.append({"mesh": mesh, "tris": sah["tris"], "bins": sah["runs"][0]["bins"],
                                 "sah_cost": sah["sah_cost"],
                                 "sweep_sah_cost": sweep["sah_cost"],
                                 "excess_pct": 100.0 * (sah["sah_cost"] / sweep["sah_cost"] - 1.0),
@@ -377,6 +377,8 @@ def bench(a, work):
     for t in threads:
         print("  %-10s %-8s 1: %.3f  2: %.3f  speed-up %.2fx  (Embree %.2fx)" % (
             t["mesh"], t["kind"], t["one"], t["two"], t["speedup"], t["embree_speedup"]))
+    for line in unavailable:
+        print("\nLeft out: %s" % line)
     load = os.getloadavg()[0]
     print("\n(load average during the run: %.1f on %d cores; ratios are back to back, the "
           "absolute figures drift with the load; %.0f s spent waiting for quiet minutes)"
@@ -403,7 +405,7 @@ def bench(a, work):
     except (OSError, IndexError):
         pass
     report = {"program": "04_bvh_bench", "images": [],
-              "machine": "%s, %d cores, load average %.1f" % (cpu, os.cpu_count(), load), "facts": {"load_average": os.getloadavg()[0]}, "rays": a.rays, "repeat": a.repeat, "load_average": load, "quiet_wait_s": gate.waited,
+              "machine": "%s, %d cores, load average %.1f" % (cpu, os.cpu_count(), load), "facts": {"load_average": os.getloadavg()[0]}, "rays": a.rays, "repeat": a.repeat, "load_average": load, "quiet_wait_s": gate.waited, "unavailable": unavailable,
               "tables": [
                   ratios_table,
                   {"id": "bench04_embree", "title": "Step 04 beside Embree 3: one thread each",

@@ -1,5 +1,5 @@
 // Step 04's engine: rays for the `trace` command and the measurements. The files it reads
-// and writes (RAYS.bin, HITS.bin) and ray sets like peer-bench's make_rays.py.
+// and writes (RAYS.bin, HITS.bin) and the ray sets of the bench and the tests.
 #pragma once
 
 #include <cstddef>
@@ -37,7 +37,7 @@ void writeRays(const std::string& path, const std::vector<Ray>& rays);
 void writeHits(const std::string& path, const std::vector<TraceHit>& hits);
 std::vector<TraceHit> readHits(const std::string& path);
 
-// Ray sets like peer-bench's make_rays.py (for tests and the measure run): primary rays of
+// Ray sets (for the bench, the tests and the measure run): primary rays of
 // a camera framing the mesh, diffuse rays from points on its surface, random rays in its
 // inflated bounds.
 enum class RayKind { Primary, Diffuse, Random };

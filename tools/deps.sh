@@ -48,8 +48,9 @@ pkgs_for() {
     echo bubblewrap python3 g++ cmake ninja-build pkg-config libglm-dev doctest-dev libstb-dev \
       libtinyobjloader-dev libcli11-dev nlohmann-json3-dev
     ;;
-  # openfoam-examples: the motorbike mesh (tools/bench/meshes.py); perf: step 05 README
-  bench) echo libbenchmark-dev libembree-dev openfoam-examples linux-perf ;;
+  # openfoam-examples, openarena-088-data: the motorbike and the interior map
+  # (tools/bench/meshes.py); perf: step 05 README
+  bench) echo libbenchmark-dev libembree-dev openfoam-examples openarena-088-data linux-perf ;;
   all) for g in "${groups[@]}"; do pkgs_for "$g"; done ;;
   *)
     echo "tools/deps.sh: unknown group '$1'" >&2

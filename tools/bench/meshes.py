@@ -1,19 +1,29 @@
 """The bench's meshes, from the repository and from the Debian packages they come from.
 
-bunny and sh1 are shipped in data/meshes/. The motorbike is converted on first use from
-Debian's openfoam-examples into a cache (default build/meshes/), with a provenance file
+bunny and sh1 are shipped in data/meshes/. The motorbike (Debian's openfoam-examples) and
+the interior map oa_thor (openarena-088-data, read by q3map.py) are converted on first use
+into a cache (default build/meshes/), with a provenance file
 beside it. A mesh that cannot be had raises Unavailable with one sentence saying why.
 """
 import gzip
 import os
 import subprocess
 import tempfile
+import zipfile
+
+try:
+    from tools.bench import q3map
+except ImportError:
+    import q3map
 
 ROOT = os.path.dirname(os.path.dirname(os.path.dirname(os.path.abspath(__file__))))
 SHIPPED = {"bunny", "sh1"}
 MOTORBIKE_PACKAGE = "openfoam-examples"
 MOTORBIKE_FILE = ("/usr/share/doc/openfoam-examples/examples/resources/geometry/"
                   "motorBike.obj.gz")
+THOR_PACKAGE = "openarena-088-data"
+THOR_FILE = "/usr/share/games/openarena/baseoa/pak6-patch088.pk3"
+THOR_MEMBER = "maps/oa_thor.bsp"
 
 
 class Unavailable(Exception):
@@ -85,6 +95,42 @@ def motorbike(cache):
     return obj
 
 
+def oa_thor(cache):
+    """The OpenArena map "Thor's Valhalla" from Debian's openarena-088-data, by q3map.py."""
+    version = package_version(THOR_PACKAGE)
+    if version is None or not os.path.exists(THOR_FILE):
+        raise Unavailable("oa_thor: Debian's %s is not installed (tools/deps.sh bench "
+                          "installs it)" % THOR_PACKAGE)
+    obj = os.path.join(cache, "oa_thor.obj")
+    about = os.path.join(cache, "oa_thor.md")
+    stamp = "Package `%s` %s" % (THOR_PACKAGE, version)
+    if os.path.exists(obj) and os.path.exists(about):
+        with open(about, encoding="utf-8") as f:
+            if stamp in f.read():
+                return obj
+    with zipfile.ZipFile(THOR_FILE) as z:
+        positions, tris, counts = q3map.triangles(z.read(THOR_MEMBER))
+    # %.9g: nine digits read back to the same float32
+    text = "".join("v %.9g %.9g %.9g\n" % p for p in positions) + "".join(
+        "f %d %d %d\n" % (a + 1, b + 1, c + 1) for a, b, c in tris)
+    os.makedirs(cache, exist_ok=True)
+    write_atomically(obj, text)
+    write_atomically(about, (
+        "# oa_thor.obj\n\n"
+        "Made by tools/bench/meshes.py (with q3map.py) on first use; delete this folder to make "
+        "it again.\n\n"
+        "%s, file `%s`, member `%s` (the OpenArena map \"Thor's Valhalla\": halls, columns, "
+        "arches, long corridors). Licence as stated by the package's copyright file, entry for "
+        "`oa_thor.*`: (c) \"Thor\", GPL-2 (version 2 only).\n\n"
+        "The static world (model 0): %d triangles, %d vertices (welded where bit-identical); "
+        "Bezier patches tessellated with %d segments per 3x3 control block; %d sky faces, %d "
+        "zero-area triangles and %d repeats left out. Z is up, units are Quake units. The "
+        "bench's inside camera: eye (960, -384, 2), looking at (960, 600, 2), up z, fov 90.\n"
+        % (stamp, THOR_FILE, THOR_MEMBER, len(tris), len(positions), q3map.SEGMENTS,
+           counts["sky"], counts["zero_area"], counts["repeats"])))
+    return obj
+
+
 def write_atomically(path, text):
     fd, tmp = tempfile.mkstemp(dir=os.path.dirname(path), prefix=".part-")
     try:
@@ -109,6 +155,5 @@ def mesh_path(name, cache, data=None):
     if name == "motorbike":
         return motorbike(cache)
     if name == "oa_thor":
-        raise Unavailable("oa_thor: the interior map needs a Quake III map reader the "
-                          "workbook does not have yet (its source: Debian's openarena-088-data)")
+        return oa_thor(cache)
     raise Unavailable("%s: no such mesh (bunny, sh1, motorbike, oa_thor)" % name)

@@ -8,7 +8,48 @@ import unittest
 import scratch  # noqa: F401  (tempfile's folders: one, removed at exit)
 
 sys.path.insert(0, os.path.dirname(os.path.dirname(os.path.dirname(os.path.abspath(__file__)))))
-from tools.bench import bench04, meshes  # noqa: E402
+from tools.bench import bench04, meshes, q3map  # noqa: E402
+
+
+def tiny_map():
+    """A Quake III map (IBSP 46) by hand: a quad as two triangles plus a repeat and a
+    zero-area triangle, a sky face, and a flat 3x3 Bezier patch at z = 5."""
+    textures = struct.pack("<64sii", b"wall", 0, 0) + struct.pack("<64sii", b"sky", 4, 0)
+    quad = [(0, 0, 0), (4, 0, 0), (4, 4, 0), (0, 4, 0)]
+    patch = [(i, j, 5) for j in range(3) for i in range(3)]
+    vertices = b"".join(struct.pack("<3f32x", *p) for p in quad + patch)
+    meshverts = struct.pack("<12i", 0, 1, 2, 0, 2, 3, 2, 1, 0, 0, 1, 1)
+
+    def face(texture, kind, vertex, count, meshvert, nmeshverts, size=(0, 0)):
+        return struct.pack("<7i", texture, 0, kind, vertex, count, meshvert, nmeshverts) + \
+            bytes(96 - 28) + struct.pack("<2i", *size)
+    faces = face(0, 1, 0, 4, 0, 12) + face(1, 1, 0, 4, 0, 6) + face(0, 2, 4, 9, 0, 0, (3, 3))
+    models = struct.pack("<6f4i", 0, 0, 0, 4, 4, 5, 0, 3, 0, 0)
+    body = {1: textures, 7: models, 10: vertices, 11: meshverts, 13: faces}
+    offset, directory, blob = 8 + 17 * 8, b"", b""
+    for i in range(17):
+        data = body.get(i, b"")
+        directory += struct.pack("<ii", offset + len(blob), len(data))
+        blob += data
+    return b"IBSP" + struct.pack("<i", 46) + directory + blob
+
+
+class QuakeMap(unittest.TestCase):
+    def test_faces_patches_and_what_is_left_out(self):
+        positions, tris, counts = q3map.triangles(tiny_map())
+        self.assertEqual(counts, {"sky": 1, "zero_area": 1, "repeats": 1})
+        # 2 triangles of the quad, 4 x 4 quads of two triangles from the patch
+        self.assertEqual(len(tris), 2 + 32)
+        self.assertEqual([positions[i] for i in tris[0]], [(0, 0, 0), (4, 0, 0), (4, 4, 0)])
+        self.assertEqual(len(positions), 4 + 25)
+        # the flat patch's control grid is x = i, y = j: its points are the grid's, e.g. the
+        # middle (1, 1, 5) and a quarter step (0.5, 0.5, 5)
+        self.assertIn((1.0, 1.0, 5.0), positions)
+        self.assertIn((0.5, 0.5, 5.0), positions)
+
+    def test_another_file_is_refused(self):
+        with self.assertRaises(ValueError):
+            q3map.triangles(b"PK\x03\x04" + bytes(200))
 
 
 class Meshes(unittest.TestCase):

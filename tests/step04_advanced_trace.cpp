@@ -259,6 +259,44 @@ TEST_SUITE("program 04") {
         CHECK(bad.exitCode != 0);
         CHECK_FALSE(std::filesystem::exists(dir.file("h3.bin")));
     }
+    TEST_CASE("rays command: the generator's rays and a camera placed inside") {
+        test::TempDir dir;
+        std::string mesh = test::dataDir() + "/meshes/sh1.obj";
+        auto run = test::runProgram(
+            program, "rays --mesh '" + mesh + "' --kind diffuse --count 500 --seed 4 --out d.bin",
+            dir);
+        REQUIRE(run.exitCode == 0);
+        CHECK(nlohmann::json::parse(run.out)["rays"] == 500);
+        std::vector<Ray> written = readRays(dir.file("d.bin"));
+        std::vector<Ray> made = makeRays(loadObj(mesh), RayKind::Diffuse, 500, 4);
+        REQUIRE(written.size() == 500);
+        for (size_t i = 0; i < 500; i += 97) {
+            CHECK(written[i].origin == made[i].origin);
+            CHECK(written[i].direction == made[i].direction);
+            CHECK(written[i].tmin == made[i].tmin);
+        }
+        // 4 rays (2 x 2 pixels) from (0, 0, 0) looking down -z with a 90 degree view: the
+        // pixel centres are at +-0.5 of the half-width 1, so each direction is
+        // (+-1, +-1, -2) / sqrt(6), row 0 at the top.
+        run = test::runProgram(
+            program,
+            "rays --mesh '" + mesh + "' --count 4 --eye 0,0,0 --look 0,0,-1 --fov 90 --out p.bin",
+            dir);
+        REQUIRE(run.exitCode == 0);
+        std::vector<Ray> camera = readRays(dir.file("p.bin"));
+        REQUIRE(camera.size() == 4);
+        float c = 1.0f / std::sqrt(6.0f);
+        CHECK(camera[0].origin == Vec3(0.0f));
+        CHECK(camera[0].direction.x == doctest::Approx(-c));
+        CHECK(camera[0].direction.y == doctest::Approx(c));
+        CHECK(camera[0].direction.z == doctest::Approx(-2 * c));
+        CHECK(camera[3].direction.x == doctest::Approx(c));
+        CHECK(camera[3].direction.y == doctest::Approx(-c));
+        auto bad = test::runProgram(
+            program, "rays --mesh '" + mesh + "' --kind random --eye 0,0,0 --out x.bin", dir);
+        CHECK(bad.exitCode != 0);
+        CHECK(bad.err.find("--eye") != std::string::npos);
+    }
     TEST_CASE("check command: real meshes against brute force with crack rays") {
         test::TempDir dir;
         auto run = test::runProgram(program,

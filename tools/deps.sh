@@ -32,7 +32,8 @@ pkgs_for() {
       libtinyobjloader-dev libcli11-dev libimgui-dev nlohmann-json3-dev libgl-dev \
       libegl1 libgl1-mesa-dri
     ;;
-  test) echo python3 python3-yaml xvfb xauth ;; # xvfb: the windows' X11 + GLX test
+  # xvfb: the windows' X11 + GLX test; libembree-dev: the bench harness's test (9 MB)
+  test) echo python3 python3-yaml xvfb xauth libembree-dev ;;
   report) echo python3 python3-matplotlib ;;
   watch) echo inotify-tools ;; # ./workbook check --watch (it polls without)
   slides)
@@ -47,7 +48,9 @@ pkgs_for() {
     echo bubblewrap python3 g++ cmake ninja-build pkg-config libglm-dev doctest-dev libstb-dev \
       libtinyobjloader-dev libcli11-dev nlohmann-json3-dev
     ;;
-  bench) echo libbenchmark-dev libembree-dev python3-numpy linux-perf ;; # perf: step 05 README
+  # openfoam-examples, openarena-088-data: the motorbike and the interior map
+  # (tools/bench/meshes.py); perf: step 05 README
+  bench) echo libbenchmark-dev libembree-dev openfoam-examples openarena-088-data linux-perf ;;
   all) for g in "${groups[@]}"; do pkgs_for "$g"; done ;;
   *)
     echo "tools/deps.sh: unknown group '$1'" >&2

@@ -5,12 +5,13 @@ usage: tools/bench/bench04.py [--rays N] [--repeat K] [--rounds R]
                         [--meshes bunny,motorbike,oa_thor] [--kinds primary,diffuse,random]
                         [--builders midpoint,median,sah,sah4,sah8,sbvh,sbvh4,sbvh8]
                         [--no-extras] [--thread-rays N] [--thread-pairs P] [--quiet-wait S]
-                        [--out out/04_bvh_bench.json] [--program PATH]
-                        [--data DIR | BOXES_MESHES=DIR] [--peer-dir DIR | BOXES_PEER_BENCH=DIR]
+                        [--out out/04_bvh_bench.json] [--program PATH] [--embree PATH]
+                        [--cache DIR] [--data DIR | BOXES_MESHES=DIR]
        (./workbook bench ...)
 
 For every mesh and ray kind (primary, diffuse, random) it writes one ray set with
-peer-bench's make_rays.py, runs peer-bench (Embree 3, one thread) and then our
+`04_bvh rays`, runs the workbook's Embree harness (tools/bench/embree_trace: Embree 3,
+`rtcIntersect1`, one thread) and then our
 `04_bvh trace` with each builder on that file (and "sah 4-wide", "sah 8-wide": the
 binned SAH tree collapsed to 4- or 8-wide nodes, `--width 4` or `--width 8`; "sbvh",
 "sbvh 4-wide" and "sbvh 8-wide": the binned SAH with spatial splits, not an exercise), each run
@@ -18,22 +19,21 @@ binned SAH tree collapsed to 4- or 8-wide nodes, `--width 4` or `--width 8`; "sb
 the ratios are the medians of the rounds' own ratios. Each round first waits (at most
 --quiet-wait s) until a short probe runs at 90% of its best speed: on a shared machine some
 minutes run memory-bound code 30-40% slower. It compares the hits ray by ray with Embree's.
-The interior map (oa_thor) gets its primary rays from the inside camera of the meshes
-README. Also: binned SAH on
+The interior map (oa_thor) gets its primary rays from a camera inside it. Also: binned SAH on
 2 threads against 1 beside Embree's own two-thread speed-up (larger ray sets, alternating
 pairs), and the full-sweep SAH cost (the quality reference). Prints the
 table builder x ray kind x mesh and writes it as JSON (for the report).
-Needs: libembree-dev, python3-numpy (tools/deps.sh bench), the release build, and two things
-the workbook does not ship: peer-bench (the Embree harness: build.sh, make_rays.py;
---peer-dir or BOXES_PEER_BENCH) and the meshes folder (MESH.obj for every --meshes name;
---data or BOXES_MESHES).
+Needs what `./workbook bench` installs and builds: libembree-dev and openfoam-examples
+(tools/deps.sh bench), 04_bvh and embree_trace in the release build. The meshes
+(tools/bench/meshes.py): the bunny from data/meshes/, the motorbike converted on first use
+from openfoam-examples into --cache (default build/meshes/); a mesh that cannot be had is
+left out with one line saying why. --data DIR (or BOXES_MESHES) reads MESH.obj from DIR
+instead.
 """
 import argparse
 import json
 import os
 import re
-import resource
-import shutil
 import signal
 import statistics
 import struct
@@ -42,14 +42,19 @@ import sys
 import tempfile
 import time
 
+try:
+    from tools.bench import meshes  # imported as tools.bench.bench04 (the tests)
+except ImportError:
+    import meshes  # run as a script: its folder is on the path
+
 ROOT = os.path.dirname(os.path.dirname(os.path.dirname(os.path.abspath(__file__))))
 INSIDE = ["--eye", "960,-384,2", "--look", "960,600,2", "--up", "0,0,1", "--fov", "90"]
 
 
-def make_rays(peer_src, obj, kind, count, out, extra=()):
-    """A ray set from peer-bench's make_rays.py (extra: its camera options, a seed)."""
-    subprocess.run(["/usr/bin/python3", os.path.join(peer_src, "make_rays.py"), obj, kind,
-                    str(count), out] + list(extra), check=True, capture_output=True)
+def make_rays(program, obj, kind, count, out, extra=()):
+    """A ray set from `04_bvh rays` (extra: its camera options, a seed)."""
+    subprocess.run([program, "rays", "--mesh", obj, "--kind", kind, "--count", str(count),
+                    "--out", out] + list(extra), check=True, capture_output=True)
 
 
 def run_json(cmd):
@@ -57,44 +62,24 @@ def run_json(cmd):
     return json.loads(out.stdout.strip().splitlines()[-1])
 
 
-def children_cpu():
-    r = resource.getrusage(resource.RUSAGE_CHILDREN)
-    return r.ru_utime + r.ru_stime
-
-
-def run_embree(cmd, repeat):
-    """peer-bench with --repeat 1 and with --repeat 1+P; returns the second run's JSON with
-    'mrays_per_cpu_s' from the CPU seconds of one trace pass, (cpu(1+P) - cpu(1)) / P (the
-    load and build cancel; P passes, about 2 s, so they are small beside the difference). On a loaded
-    machine the wall time mostly measures the scheduler; CPU time does not (though the
-    cache still suffers from the neighbours)."""
-    c0 = children_cpu()
-    first = run_json(cmd + ["--repeat", "1"])
-    c1 = children_cpu()
-    # Enough passes for about 2 s of tracing: the difference must dwarf the noise of the
-    # load and build (some 50 ms of CPU time).
-    passes = max(4 * repeat, min(400, int(2000.0 / max(1e-3, first["trace_ms"])) + 1))
-    j = run_json(cmd + ["--repeat", str(1 + passes)])
-    c2 = children_cpu()
-    j["mrays_per_cpu_s"] = j["rays"] / max(1e-9, ((c2 - c1) - (c1 - c0)) / passes) / 1e6
-    return j
-
-
-def embree_tree_sah(peer, obj, rays, work):
+def embree_tree_sah(embree, obj, rays, work):
     """The SAH cost Embree prints for the tree it traces (verbose=3: each node its area, each
     leaf its area times its blocks of four, over the root's; the last build is the traced
     one), from one traced ray. None when its output has no such line."""
     one = os.path.join(work, "one-ray.bin")
     with open(rays, "rb") as f, open(one, "wb") as g:
         g.write(f.read(32))
-    out = subprocess.run([peer, obj, one, os.path.join(work, "one-hit.bin"), "--repeat", "1",
-                          "--config", "verbose=3"], capture_output=True, text=True)
+    out = subprocess.run([embree, "--mesh", obj, "--rays", one, "--hits",
+                          os.path.join(work, "one-hit.bin"), "--config", "verbose=3"],
+                         capture_output=True, text=True)
     costs = re.findall(r"total\s*: sah =\s*([0-9.]+)", out.stdout + out.stderr)
     return float(costs[-1]) if costs else None
 
 
 def run_ours(cmd, repeat):
-    """Our trace reports the CPU time of its trace passes itself (trace_cpu_ms, median)."""
+    """Our trace and embree_trace report the CPU time of their trace passes themselves
+    (trace_cpu_ms, median): on a loaded machine the wall time mostly measures the scheduler;
+    CPU time does not (though the cache still suffers from the neighbours)."""
     j = run_json(cmd + ["--repeat", str(repeat)])
     j["mrays_per_cpu_s"] = j["rays"] / max(1e-9, j["trace_cpu_ms"] / 1e3) / 1e6
     return j
@@ -108,15 +93,12 @@ class QuietGate:
     a round starts once the probe reaches 90% of the best it reached in this run, or after
     --quiet-wait seconds."""
 
-    def __init__(self, a, peer_src, work):
+    def __init__(self, a, obj, work):
         self.cmd, self.best, self.waited, self.max_wait = None, 0.0, 0.0, a.quiet_wait
         if a.quiet_wait <= 0:
             return
-        obj = os.path.join(a.data, "bunny.obj")
-        if not os.path.exists(obj):
-            obj = os.path.join(a.data, a.meshes.split(",")[0] + ".obj")
         rays = os.path.join(work, "probe.bin")
-        make_rays(peer_src, obj, "diffuse", 100000, rays, ["--seed", "11"])
+        make_rays(a.program, obj, "diffuse", 100000, rays, ["--seed", "11"])
         self.cmd = [a.program, "trace", "--mesh", obj, "--rays", rays, "--hits",
                     os.path.join(work, "probe-hits.bin"), "--width", "8", "--repeat", "3"]
         for _ in range(3):  # a first reference
@@ -162,15 +144,15 @@ def agreement(ours, theirs):
     return same / max(1, len(ours))
 
 
-def measure_threads(a, peer, obj, mesh, kind, work, gate):
+def measure_threads(a, obj, mesh, kind, work, gate):
     """Two threads against one on a larger ray set (--thread-rays: a pass must last long
     enough that starting the threads and the scheduler's noise do not count), in alternating
     pairs, ours (binned SAH) and Embree's; the medians of the pairs' speed-ups. Each pair
     waits for a quiet minute first, as the rounds do. Embree's speed-up beside ours is not
-    the machine's ceiling: peer-bench starts its threads for every pass."""
+    the machine's ceiling: embree_trace starts its threads for every pass."""
     rays = os.path.join(work, "%s-%s-threads.bin" % (mesh, kind))
     extra = INSIDE if (mesh == "oa_thor" and kind == "primary") else []
-    make_rays(os.path.dirname(peer), obj, kind, a.thread_rays, rays, ["--seed", "7"] + extra)
+    make_rays(a.program, obj, kind, a.thread_rays, rays, ["--seed", "7"] + extra)
     hits = os.path.join(work, "threads-hits.bin")
     speed = {"ours": {1: [], 2: []}, "embree": {1: [], 2: []}}
     for _ in range(a.thread_pairs):
@@ -180,7 +162,7 @@ def measure_threads(a, peer, obj, mesh, kind, work, gate):
                 [a.program, "trace", "--mesh", obj, "--rays", rays, "--hits", hits, "--threads",
                  str(n), "--repeat", str(a.repeat)])["mrays_per_s"])
             speed["embree"][n].append(run_json(
-                [peer, obj, rays, hits, "--threads", str(n), "--repeat",
+                [a.embree, "--mesh", obj, "--rays", rays, "--hits", hits, "--threads", str(n), "--repeat",
                  str(a.repeat)])["mrays_per_s"])
 
     def speedup(who):
@@ -193,23 +175,6 @@ def measure_threads(a, peer, obj, mesh, kind, work, gate):
     print("%-9s %-8s threads: ours 1: %.3f  2: %.3f Mrays/s  speed-up %.2fx (Embree's %.2fx)"
           % (mesh, kind, t["one"], t["two"], t["speedup"], t["embree_speedup"]), file=sys.stderr)
     return t
-
-
-def outside_paths(data, peer_dir):
-    """(meshes folder, peer-bench folder) from the flags or, without them, BOXES_MESHES and
-    BOXES_PEER_BENCH; raises SystemExit with one line naming the flag and the variable when
-    one is missing or not a folder."""
-    found = []
-    for value, flag, variable, what in (
-            (data, "--data", "BOXES_MESHES", "the meshes folder (MESH.obj for every --meshes name)"),
-            (peer_dir, "--peer-dir", "BOXES_PEER_BENCH", "peer-bench, the Embree harness (build.sh, make_rays.py)")):
-        value = value or os.environ.get(variable, "")
-        if not value:
-            raise SystemExit(f"bench04: {what} is not given: pass {flag} DIR or set {variable}")
-        if not os.path.isdir(value):
-            raise SystemExit(f"bench04: {flag} / {variable} {value}: no such folder")
-        found.append(value)
-    return tuple(found)
 
 
 def main():
@@ -228,14 +193,22 @@ def main():
                     help="rays per set for the two-thread row (primary and diffuse)")
     ap.add_argument("--thread-pairs", type=int, default=5,
                     help="alternating 1-thread/2-thread pairs for the two-thread row")
-    ap.add_argument("--data", help="the meshes folder (default $BOXES_MESHES)")
+    ap.add_argument("--data", default=os.environ.get("BOXES_MESHES") or None,
+                    help="read MESH.obj from this folder instead (default $BOXES_MESHES; "
+                         "unset: the shipped and converted meshes)")
+    ap.add_argument("--cache", default=os.path.join(ROOT, "build", "meshes"),
+                    help="where meshes converted from Debian packages are kept")
     ap.add_argument("--out", default=os.path.join(ROOT, "out", "04_bvh_bench.json"))
     ap.add_argument("--program", default=os.path.join(ROOT, "build/release/steps/04_bvh/04_bvh"))
-    ap.add_argument("--peer-dir", help="peer-bench's folder (default $BOXES_PEER_BENCH)")
+    ap.add_argument("--embree", default=os.path.join(ROOT, "build/release/tools/bench/embree_trace"),
+                    help="the Embree harness (tools/bench/embree_trace.cpp)")
     ap.add_argument("--quiet-wait", type=float, default=60,
                     help="seconds a round may wait for a quiet minute (0: no probe, no wait)")
     a = ap.parse_args()
-    a.data, a.peer_dir = outside_paths(a.data, a.peer_dir)
+    for path, what in ((a.program, "04_bvh"), (a.embree, "embree_trace")):
+        if not os.access(path, os.X_OK):
+            raise SystemExit(f"bench04: no {what} at {path}: ./workbook bench builds it (Embree's "
+                             "harness needs libembree-dev: tools/deps.sh bench)")
 
     # A private scratch folder, removed however the run ends (Ctrl-C, SIGTERM, a failure).
     signal.signal(signal.SIGTERM, lambda *_: sys.exit(143))
@@ -244,20 +217,24 @@ def main():
 
 
 def bench(a, work):
-    peer_src = os.path.join(work, "peer-bench")
-    shutil.copytree(a.peer_dir, peer_src)  # built in a copy: its folder may be read-only
-    # Embree's own build script uses -march=native: that is Embree's side, ours stays portable.
-    subprocess.run(["sh", os.path.join(peer_src, "build.sh")], check=True, capture_output=True)
-    peer = os.path.join(peer_src, "peer-bench")
-    gate = QuietGate(a, peer_src, work)
-    rows, threads, quality, tree_sah = [], [], [], {}
+    objs, unavailable = {}, []
     for mesh in a.meshes.split(","):
-        obj = os.path.join(a.data, mesh + ".obj")
+        try:
+            objs[mesh] = meshes.mesh_path(mesh, a.cache, a.data)
+        except meshes.Unavailable as e:
+            unavailable.append(str(e))
+            print("bench04: left out: %s" % e, file=sys.stderr)
+    if not objs:
+        raise SystemExit("bench04: none of the meshes %s can be had" % a.meshes)
+    a.meshes = ",".join(objs)
+    gate = QuietGate(a, objs.get("bunny", next(iter(objs.values()))), work)
+    rows, threads, quality, tree_sah = [], [], [], {}
+    for mesh, obj in objs.items():
         sweep = None
         for kind in a.kinds.split(","):
             rays = os.path.join(work, "%s-%s.bin" % (mesh, kind))
             extra = INSIDE if (mesh == "oa_thor" and kind == "primary") else []
-            make_rays(peer_src, obj, kind, a.rays, rays, extra)
+            make_rays(a.program, obj, kind, a.rays, rays, extra)
             # Rounds: Embree, then every builder, again and again; each ratio is the median
             # of the rounds' own ratios, so a burst of load on a shared machine spoils one
             # round, not the comparison (a single run drifts by 10-20%).
@@ -277,8 +254,8 @@ def bench(a, work):
             embree_runs, our_runs, agree = [], {b: [] for b, _ in variants}, {}
             for round_index in range(a.rounds):
                 gate.wait()
-                embree_runs.append(run_embree([peer, obj, rays, ehits, "--threads", "1"],
-                                              a.repeat))
+                embree_runs.append(run_ours([a.embree, "--mesh", obj, "--rays", rays, "--hits",
+                                             ehits, "--threads", "1"], a.repeat))
                 eh = read_hits(ehits) if round_index == 0 else None
                 for builder, args in variants:
                     our_runs[builder].append(run_ours(
@@ -315,11 +292,11 @@ def bench(a, work):
                          ratios[-1], row["cpu_ratio"], row["build_ms"], row["sah_cost"],
                          row["agree_with_embree"]), file=sys.stderr)
             if kind in ("primary", "diffuse") and not a.no_extras:
-                threads.append(measure_threads(a, peer, obj, mesh, kind, work, gate))
+                threads.append(measure_threads(a, obj, mesh, kind, work, gate))
             if mesh not in tree_sah and not a.no_extras:
                 ours = {r["builder"]: r["runs"][0].get("sah_cost_8wide") for r in rows
                         if r["mesh"] == mesh and r["builder"] in ("sah 8-wide", "sbvh 8-wide")}
-                tree_sah[mesh] = {"embree": embree_tree_sah(peer, obj, rays, work),
+                tree_sah[mesh] = {"embree": embree_tree_sah(a.embree, obj, rays, work),
                                   "sah8": ours.get("sah 8-wide"), "sbvh8": ours.get("sbvh 8-wide")}
             if sweep is None and not a.no_extras:
                 sweep = run_json([a.program, "trace", "--mesh", obj, "--rays", rays, "--hits", ohits,
@@ -328,7 +305,7 @@ def bench(a, work):
                 if not sah:
                     continue
                 sah = sah[0]
-                quality.append({"mesh": mesh, "tris": sah["tris"], "bins": sah["bins"],
+                quality.append({"mesh": mesh, "tris": sah["tris"], "bins": sah["runs"][0]["bins"],
                                 "sah_cost": sah["sah_cost"],
                                 "sweep_sah_cost": sweep["sah_cost"],
                                 "excess_pct": 100.0 * (sah["sah_cost"] / sweep["sah_cost"] - 1.0),
@@ -396,10 +373,12 @@ def bench(a, work):
                     (t["embree"], t["sah8"], t["sbvh8"]))))
     print("\nTwo threads against one (binned SAH; %d rays per set, medians of %d alternating "
           "pairs; Embree's own speed-up on the same rays beside it, its threads started for "
-          "every pass by peer-bench):" % (a.thread_rays, a.thread_pairs))
+          "every pass by embree_trace):" % (a.thread_rays, a.thread_pairs))
     for t in threads:
         print("  %-10s %-8s 1: %.3f  2: %.3f  speed-up %.2fx  (Embree %.2fx)" % (
             t["mesh"], t["kind"], t["one"], t["two"], t["speedup"], t["embree_speedup"]))
+    for line in unavailable:
+        print("\nLeft out: %s" % line)
     load = os.getloadavg()[0]
     print("\n(load average during the run: %.1f on %d cores; ratios are back to back, the "
           "absolute figures drift with the load; %.0f s spent waiting for quiet minutes)"
@@ -426,7 +405,7 @@ def bench(a, work):
     except (OSError, IndexError):
         pass
     report = {"program": "04_bvh_bench", "images": [],
-              "machine": "%s, %d cores, load average %.1f" % (cpu, os.cpu_count(), load), "facts": {"load_average": os.getloadavg()[0]}, "rays": a.rays, "repeat": a.repeat, "load_average": load, "quiet_wait_s": gate.waited,
+              "machine": "%s, %d cores, load average %.1f" % (cpu, os.cpu_count(), load), "facts": {"load_average": os.getloadavg()[0]}, "rays": a.rays, "repeat": a.repeat, "load_average": load, "quiet_wait_s": gate.waited, "unavailable": unavailable,
               "tables": [
                   ratios_table,
                   {"id": "bench04_embree", "title": "Step 04 beside Embree 3: one thread each",
@@ -439,8 +418,8 @@ def bench(a, work):
                            "run the median of %d passes; Mrays/s the median of the rounds; "
                            "'ratio' (the median of the rounds' ratios) "
                            "from wall times, 'CPU ratio' from the CPU seconds of a trace pass "
-                           "(ours: measured in the program; Embree: runs with --repeat 1 and 1+P, "
-                           "the difference over P (about 2 s of passes); steadier on a loaded machine); 'agree': share of rays with Embree's triangle or t; "
+                           "(each program measures its own passes; steadier on a loaded machine); "
+                           "'agree': share of rays with Embree's triangle or t; "
                            "each round began once a probe ran at 90%% of its best speed (%.0f s "
                            "of waiting in all, at most %.0f s per round)"
                            % (a.rounds, a.repeat, gate.waited, a.quiet_wait)},
@@ -455,7 +434,7 @@ def bench(a, work):
                    "columns": ["mesh", "Embree", "sah 8-wide", "sbvh 8-wide"],
                    "rows": [[m, t["embree"], t["sah8"], t["sbvh8"]]
                             for m, t in tree_sah.items()],
-                   "note": "The SAH cost Embree prints for its traced tree (peer-bench --config "
+                   "note": "The SAH cost Embree prints for its traced tree (embree_trace --config "
                            "verbose=3: each 8-wide node its area, each leaf its area times its "
                            "blocks of four triangles, over the root's area) and ours in the same "
                            "units (trace --width 8: sah_cost_8wide, packets for blocks); lower "
@@ -466,7 +445,7 @@ def bench(a, work):
                    "rows": [[t["mesh"], t["kind"], t["one"], t["two"], t["speedup"],
                              t["embree_speedup"]] for t in threads],
                    "note": "Mrays/s; %d rays per set, medians of %d alternating 1/2-thread "
-                           "pairs; ours keeps its worker threads between passes; peer-bench "
+                           "pairs; ours keeps its worker threads between passes; embree_trace "
                            "starts Embree's threads for every pass while its main thread "
                            "waits, which held our tracer to 1.0-1.2x on short passes, so "
                            "Embree's speed-up beside ours is not the machine's ceiling"

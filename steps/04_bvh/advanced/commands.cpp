@@ -1,5 +1,6 @@
 #include "04_bvh/advanced/commands.hpp"
 
+#include <cstdio>
 #include <ctime>
 #include <iostream>
 #include <nlohmann/json.hpp>
@@ -101,6 +102,48 @@ int runTrace(const TraceCommandOptions& o) {
     return 0;
 }
 
+RayKind parseRayKind(const std::string& kind) {
+    return kind == "primary"   ? RayKind::Primary
+           : kind == "diffuse" ? RayKind::Diffuse
+                               : RayKind::Random;
+}
+
+Vec3 parseTriple(const std::string& text, const std::string& flag) {
+    Vec3 v;
+    char tail = 0;
+    if (std::sscanf(text.c_str(), "%f,%f,%f%c", &v.x, &v.y, &v.z, &tail) != 3 || !isFinite(v))
+        throw InputError(flag + " '" + printable(text) + "': expected three numbers X,Y,Z");
+    return v;
+}
+
+// `rays`: write a generated ray set; one JSON line says what was written.
+int runRays(const RaysCommandOptions& o) {
+    Mesh mesh = loadObj(o.mesh);
+    std::vector<Ray> rays;
+    nlohmann::json j = {{"mesh", o.mesh}, {"kind", o.kind}, {"seed", o.seed}};
+    if (!o.eye.empty()) {
+        if (o.kind != "primary") throw InputError("--eye places a camera: only for --kind primary");
+        Vec3 eye = parseTriple(o.eye, "--eye");
+        Bounds3f bounds;
+        for (const Vec3& p : mesh.positions) bounds.extend(p);
+        Vec3 look = o.look.empty() ? bounds.centroid() : parseTriple(o.look, "--look");
+        Camera camera = Camera::lookingAt(eye, look, parseTriple(o.up, "--up"), o.fov, 1.0f);
+        try {
+            camera.validate();
+        } catch (const std::invalid_argument& e) {
+            throw InputError(std::string("rays: ") + e.what());
+        }
+        rays = makeCameraRays(camera, o.count);
+        j["eye"] = o.eye;
+    } else {
+        rays = makeRays(mesh, parseRayKind(o.kind), o.count, o.seed);
+    }
+    writeRays(o.out, rays);
+    j["rays"] = rays.size();
+    std::cout << j.dump() << "\n";
+    return 0;
+}
+
 // `check`: every builder's nearest hits against brute force over all triangles, and
 // optionally rays aimed at shared edges and vertices. Exit 1 on any difference.
 int runCheck(const CheckCommandOptions& o) {
@@ -109,10 +152,7 @@ int runCheck(const CheckCommandOptions& o) {
     if (!o.rays.empty()) {
         rays = readRays(o.rays);
     } else {
-        RayKind kind = o.kind == "primary"   ? RayKind::Primary
-                       : o.kind == "diffuse" ? RayKind::Diffuse
-                                             : RayKind::Random;
-        rays = makeRays(mesh, kind, o.count, o.seed);
+        rays = makeRays(mesh, parseRayKind(o.kind), o.count, o.seed);
     }
     Stopwatch watch;
     std::vector<TraceHit> reference;
@@ -211,12 +251,35 @@ EngineCommands::EngineCommands(CLI::App& app) {
                               "also this many rays per feature at shared edges and vertices");
     checkCommand_->add_option("--threads", check_.threads, "threads (0: all)");
     checkCommand_->add_option("--seed", check_.seed, "seed of generated rays");
+    raysCommand_ = app.add_subcommand(
+        "rays", "write a ray set for MESH.obj as RAYS.bin (float32 ox oy oz tmin dx dy dz tmax)");
+    raysCommand_->add_option("--mesh", rays_.mesh, "the mesh (OBJ)")->required();
+    raysCommand_->add_option("--out", rays_.out, "the rays file written")->required();
+    raysCommand_
+        ->add_option("--kind", rays_.kind,
+                     "primary (a camera framing the mesh), diffuse (from its surface), random")
+        ->check(CLI::IsMember({"primary", "diffuse", "random"}))
+        ->capture_default_str();
+    raysCommand_->add_option("--count", rays_.count, "rays")
+        ->check(CLI::Range(size_t(1), kMaxRays))
+        ->capture_default_str();
+    raysCommand_->add_option("--seed", rays_.seed, "seed (diffuse and random rays)")
+        ->capture_default_str();
+    raysCommand_->add_option("--eye", rays_.eye, "primary rays from this eye X,Y,Z instead");
+    raysCommand_->add_option("--look", rays_.look,
+                             "with --eye: the point looked at (default: "
+                             "the mesh's centre)");
+    raysCommand_->add_option("--up", rays_.up, "with --eye: the up vector")->capture_default_str();
+    raysCommand_->add_option("--fov", rays_.fov, "with --eye: the field of view in degrees")
+        ->check(CLI::Range(1.0f, 179.0f))
+        ->capture_default_str();
     app.require_subcommand(0, 1);
 }
 
 std::optional<int> EngineCommands::run() const {
     if (*traceCommand_) return runTrace(trace_);
     if (*checkCommand_) return runCheck(check_);
+    if (*raysCommand_) return runRays(rays_);
     return std::nullopt;
 }
 

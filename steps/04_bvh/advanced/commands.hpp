@@ -1,6 +1,7 @@
 // Step 04's engine: the 04_bvh program's commands. `trace` traces a rays file against a
 // mesh with any builder and width and prints one JSON line (so any tracer can be compared
-// with this one, ray by ray and in speed); `check` compares every tree with brute force.
+// with this one, ray by ray and in speed); `check` compares every tree with brute force;
+// `rays` writes ray sets.
 #pragma once
 
 #include <CLI/CLI.hpp>
@@ -16,6 +17,15 @@ struct TraceCommandOptions {
     std::string mesh, rays, hits, builder = "sah";
     int threads = 1, repeat = 1, bins = BvhBuildOptions{}.bins, width = 2;
     bool count = false;
+};
+
+// `rays`: a ray set written as RAYS.bin, for any tracer (the bench gives the same file to
+// Embree and to `trace`). A primary set with --eye uses that camera instead of the framing one.
+struct RaysCommandOptions {
+    std::string mesh, out, kind = "primary", eye, look, up = "0,1,0";
+    size_t count = 10000;
+    uint64_t seed = 1;
+    float fov = 60.0f;
 };
 
 struct CheckCommandOptions {
@@ -39,7 +49,9 @@ public:
 private:
     TraceCommandOptions trace_;
     CheckCommandOptions check_;
+    RaysCommandOptions rays_;
     CLI::App* traceCommand_ = nullptr;
+    CLI::App* raysCommand_ = nullptr;
     CLI::App* checkCommand_ = nullptr;
 };
 

@@ -6,7 +6,6 @@
 #include <fstream>
 #include <random>
 
-#include "core/camera.hpp"
 #include "core/image.hpp"
 
 namespace boxes {
@@ -111,18 +110,11 @@ std::vector<Ray> makeRays(const Mesh& mesh, RayKind kind, size_t count, uint64_t
     rays.reserve(count);
     if (kind == RayKind::Primary) {
         // A pinhole camera looking at the centre from (1,1,1), the bounding sphere in view.
-        int side = std::max(1, int(std::lround(std::sqrt(double(count)))));
         Camera camera;
         camera.fovYDegrees = 60.0f;
-        camera.aspect = 1.0f;
         camera.view = -glm::normalize(Vec3(1.0f));
         camera.eye = centre - camera.view * (0.5f * diagonal / std::sin(glm::radians(30.0f)));
-        CameraBasisT<float> basis = camera.basis();
-        for (size_t i = 0; i < count; ++i) {
-            int x = int(i % size_t(side)), y = int(i / size_t(side)) % side;
-            rays.emplace_back(camera.eye,
-                              camera.directionThrough(basis, x + 0.5f, y + 0.5f, side, side));
-        }
+        return makeCameraRays(camera, count);
     } else if (kind == RayKind::Diffuse) {
         // Area-weighted points on the surface, cosine-weighted directions about the normal.
         std::vector<double> cumulative(mesh.triangles.size());
@@ -153,6 +145,21 @@ std::vector<Ray> makeRays(const Mesh& mesh, RayKind kind, size_t count, uint64_t
             Vec3 o = lo + Vec3(uniform(rng), uniform(rng), uniform(rng)) * size;
             rays.emplace_back(o, unitVector());
         }
+    }
+    return rays;
+}
+
+std::vector<Ray> makeCameraRays(const Camera& camera, size_t count) {
+    Camera square = camera;
+    square.aspect = 1.0f;
+    int side = std::max(1, int(std::lround(std::sqrt(double(count)))));
+    CameraBasisT<float> basis = square.basis();
+    std::vector<Ray> rays;
+    rays.reserve(count);
+    for (size_t i = 0; i < count; ++i) {
+        int x = int(i % size_t(side)), y = int(i / size_t(side)) % side;
+        rays.emplace_back(square.eye,
+                          square.directionThrough(basis, x + 0.5f, y + 0.5f, side, side));
     }
     return rays;
 }

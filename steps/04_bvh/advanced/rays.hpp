@@ -1,5 +1,5 @@
 // Step 04's engine: rays for the `trace` command and the measurements. The files it reads
-// and writes (RAYS.bin, HITS.bin) and ray sets like peer-bench's make_rays.py.
+// and writes (RAYS.bin, HITS.bin) and the ray sets of the bench and the tests.
 #pragma once
 
 #include <cstddef>
@@ -8,6 +8,7 @@
 #include <vector>
 
 #include "04_bvh/trace.hpp"
+#include "core/camera.hpp"
 
 namespace boxes {
 
@@ -36,11 +37,15 @@ void writeRays(const std::string& path, const std::vector<Ray>& rays);
 void writeHits(const std::string& path, const std::vector<TraceHit>& hits);
 std::vector<TraceHit> readHits(const std::string& path);
 
-// Ray sets like peer-bench's make_rays.py (for tests and the measure run): primary rays of
+// Ray sets (for the bench, the tests and the measure run): primary rays of
 // a camera framing the mesh, diffuse rays from points on its surface, random rays in its
 // inflated bounds.
 enum class RayKind { Primary, Diffuse, Random };
 const char* rayKindName(RayKind kind);
 std::vector<Ray> makeRays(const Mesh& mesh, RayKind kind, size_t count, uint64_t seed);
+// Primary rays of a given camera (its aspect ignored): a square image of round(sqrt(count))
+// pixels a side, row 0 at the top, pixel centres, repeated from the top when count is not a
+// square. The `rays` command uses it for a camera inside a scene.
+std::vector<Ray> makeCameraRays(const Camera& camera, size_t count);
 
 }  // namespace boxes

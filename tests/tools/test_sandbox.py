@@ -53,12 +53,16 @@ class BubblewrapPrefix(unittest.TestCase):
     def test_hidden_folders_are_covered_and_readable_ones_shown(self):
         home = os.path.expanduser("~")
         work = os.path.join(home, "boxes-test-no-such-folder")
-        prefix = sandbox.bwrap_prefix([work], work, 1 << 20, hidden=["/tmp", home, "/nonexistent"],
+        # A path made absent here: "/nonexistent" is a system user's home, which a tool
+        # running as such a user may create.
+        with tempfile.TemporaryDirectory() as scratch:
+            absent = os.path.join(scratch, "absent")
+        prefix = sandbox.bwrap_prefix([work], work, 1 << 20, hidden=["/tmp", home, absent],
                                       readable=["/usr"])
         text = " ".join(prefix)
         self.assertIn(f"--tmpfs {home}", text)
         self.assertIn(f"--remount-ro {home}", text)
-        self.assertNotIn("--tmpfs /nonexistent", text)  # only folders that exist
+        self.assertNotIn(f"--tmpfs {absent}", text)  # only folders that exist
         self.assertIn(f"--size {1 << 20} --tmpfs /tmp", text)
         self.assertIn("--ro-bind /usr /usr", text)
         self.assertIn(f"--bind {work} {work}", text)

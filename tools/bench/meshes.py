@@ -71,18 +71,14 @@ def motorbike(cache):
     if version is None or not os.path.exists(MOTORBIKE_FILE):
         raise Unavailable("motorbike: Debian's %s is not installed (tools/deps.sh bench "
                           "installs it)" % MOTORBIKE_PACKAGE)
-    obj = os.path.join(cache, "motorbike.obj")
-    about = os.path.join(cache, "motorbike.md")
     stamp = "Package `%s` %s" % (MOTORBIKE_PACKAGE, version)
-    if os.path.exists(obj) and os.path.exists(about):
-        with open(about, encoding="utf-8") as f:
-            if stamp in f.read():
-                return obj
+    return cached(cache, "motorbike", stamp, lambda: make_motorbike(stamp))
+
+
+def make_motorbike(stamp):
     with gzip.open(MOTORBIKE_FILE, "rt", encoding="latin-1") as f:
         text, counts = convert_motorbike(f)
-    os.makedirs(cache, exist_ok=True)
-    write_atomically(obj, text)
-    write_atomically(about, (
+    return text, (
         "# motorbike.obj\n\n"
         "Made by tools/bench/meshes.py on first use; delete this folder to make it again.\n\n"
         "%s, file `%s` (OpenFOAM's motorbike-with-rider geometry). Licence as stated by the "
@@ -91,8 +87,7 @@ def motorbike(cache):
         "file order, %d of them, after leaving out %d that repeat an earlier triangle's three "
         "vertices (the same surface listed in two groups), so that a hit's triangle index is "
         "never ambiguous. Z is up; the bike runs along x.\n"
-        % (stamp, MOTORBIKE_FILE, counts["vertices"], counts["triangles"], counts["dropped"])))
-    return obj
+        % (stamp, MOTORBIKE_FILE, counts["vertices"], counts["triangles"], counts["dropped"]))
 
 
 def oa_thor(cache):
@@ -101,21 +96,17 @@ def oa_thor(cache):
     if version is None or not os.path.exists(THOR_FILE):
         raise Unavailable("oa_thor: Debian's %s is not installed (tools/deps.sh bench "
                           "installs it)" % THOR_PACKAGE)
-    obj = os.path.join(cache, "oa_thor.obj")
-    about = os.path.join(cache, "oa_thor.md")
     stamp = "Package `%s` %s" % (THOR_PACKAGE, version)
-    if os.path.exists(obj) and os.path.exists(about):
-        with open(about, encoding="utf-8") as f:
-            if stamp in f.read():
-                return obj
+    return cached(cache, "oa_thor", stamp, lambda: make_oa_thor(stamp))
+
+
+def make_oa_thor(stamp):
     with zipfile.ZipFile(THOR_FILE) as z:
         positions, tris, counts = q3map.triangles(z.read(THOR_MEMBER))
     # %.9g: nine digits read back to the same float32
     text = "".join("v %.9g %.9g %.9g\n" % p for p in positions) + "".join(
         "f %d %d %d\n" % (a + 1, b + 1, c + 1) for a, b, c in tris)
-    os.makedirs(cache, exist_ok=True)
-    write_atomically(obj, text)
-    write_atomically(about, (
+    return text, (
         "# oa_thor.obj\n\n"
         "Made by tools/bench/meshes.py (with q3map.py) on first use; delete this folder to make "
         "it again.\n\n"
@@ -127,7 +118,22 @@ def oa_thor(cache):
         "zero-area triangles and %d repeats left out. Z is up, units are Quake units. The "
         "bench's inside camera: eye (960, -384, 2), looking at (960, 600, 2), up z, fov 90.\n"
         % (stamp, THOR_FILE, THOR_MEMBER, len(tris), len(positions), q3map.SEGMENTS,
-           counts["sky"], counts["zero_area"], counts["repeats"])))
+           counts["sky"], counts["zero_area"], counts["repeats"]))
+
+
+def cached(cache, name, stamp, make):
+    """cache/NAME.obj, made by make() -> (obj text, provenance text) unless the provenance
+    beside it already names this package version (stamp)."""
+    obj = os.path.join(cache, name + ".obj")
+    about = os.path.join(cache, name + ".md")
+    if os.path.exists(obj) and os.path.exists(about):
+        with open(about, encoding="utf-8") as f:
+            if stamp in f.read():
+                return obj
+    text, provenance = make()
+    os.makedirs(cache, exist_ok=True)
+    write_atomically(obj, text)
+    write_atomically(about, provenance)
     return obj
 
 

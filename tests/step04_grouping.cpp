@@ -70,7 +70,10 @@ TEST_SUITE("exercise 4.4") {
         //       |2.5 - 4.5| > 1/2: missed.  Nearest hit so far: t = 2.
         //   B2 popped: entered at t = 6 > 2, skipped, G3 and G4 never tested, though the
         //       ray enters both (t = 6 and t = 9) and hits an object in each ((6, 4) at
-        //       t = 6, (10, 6) at t = 10).
+        //       t = 6, (10, 6) at t = 10). A traversal without this check at the pop
+        //       still tests none of their objects (G3's and G4's boxes, tested against
+        //       t = 2, are missed): only one that tests boxes against the ray's own tmax,
+        //       or visits B2 first, tests the four objects, and fails below.
         // So the traversal tests 2 of the 8 objects and returns slot 0 at t = 2.
         Mesh mesh = groupingMesh();
         Bvh bvh = groupingTree(mesh);

@@ -35,7 +35,11 @@ Table measureBvhCracks(const std::vector<NamedMesh>& meshes, size_t raysPerFeatu
         variants.push_back({BvhBuilder::SpatialSah, 2});
         variants.push_back({BvhBuilder::BinnedSah, 4});
         variants.push_back({BvhBuilder::BinnedSah, 8});
-        for (auto [builder, width] : variants) {
+        for (const Variant& variant : variants) {
+            // Plain copies, not a structured binding: clang 14 (Debian 12's, the fuzz
+            // build's compiler) cannot capture a binding in the lambda below.
+            const BvhBuilder builder = variant.builder;
+            const int width = variant.width;
             BvhBuildOptions options;
             options.builder = builder;
             Bvh bvh = buildEngineBvh(*m.mesh, options);

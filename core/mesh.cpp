@@ -79,7 +79,8 @@ namespace {
 //   here so memory is bounded before anything is allocated.
 // tinyobjloader's "vw VERTEX JOINT WEIGHT ..." (skin weights, unused here) converts each
 // joint to int unchecked: 1e38 is undefined behaviour (found by fuzzing). Every field must
-// be a plain number, the vertex and joints decimal integers in int range (checkSkinWeights).
+// be a plain number, the vertex and joints decimal integers in int range (checkSkinWeights), and
+// no blanks may follow the last field).
 bool isBlank(char c) {
     return c == ' ' || c == '\t';
 }
@@ -131,6 +132,11 @@ void checkSkinWeights(std::string_view rest, const Where& where) {
         ++index;
         i = j;
     }
+    // tinyobjloader reads another joint while the line goes on: after trailing blanks it
+    // finds none, takes -1 and refuses the file as "joint_id is negative" (found by the
+    // fuzz target's strict reader). Say what is wrong instead.
+    if (index > 0 && (rest.back() == ' ' || rest.back() == '\t'))
+        throw InputError(where() + "vertex weight line ends in blanks after its last field");
 }
 
 // How many v, vt and vn lines came before: a face may use only those.

@@ -104,6 +104,8 @@ std::optional<std::vector<Triangle>> strictRead(std::string_view text) {
                 for (size_t k = 1; k + 1 < corners.size(); ++k)
                     triangles.push_back({corners[0], corners[k], corners[k + 1]});
         } else if (key == "vw") {
+            // Blanks after the last field are refused (tinyobjloader reads a missing joint).
+            if (!args.empty() && (line.back() == ' ' || line.back() == '\t')) return std::nullopt;
             for (size_t i = 0; i < args.size(); ++i) {
                 long long k = 0;
                 double x = 0.0;

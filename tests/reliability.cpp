@@ -142,6 +142,18 @@ TEST_SUITE("hard cases reliability") {
         CHECK(refusal(tri + "vw 0 1 x\n") == "x.obj:5: vertex weight field 'x' is not a number");
         CHECK(parseObj(tri + "vw 0 1 0.5 2 -0.25\n").triangleCount() == 1);
     }
+    TEST_CASE("hard case: an OBJ vertex weight line that ends in blanks is refused with its line") {
+        // tinyobjloader reads one more joint after a trailing blank, finds none and refused
+        // the file with "joint_id is negative" (found by the fuzz target's strict reader,
+        // fuzz/corpus/obj/crash-79d2ff...). Blanks only, after the keyword, are no field.
+        const std::string tri = "v 0 0 0\nv 1 0 0\nv 0 1 0\nf 1 2 3\n";
+        CHECK(refusal(tri + "vw 0 \n") ==
+              "x.obj:5: vertex weight line ends in blanks after its last field");
+        CHECK(refusal(tri + "vw 0 1 0.5\t\r\n") ==
+              "x.obj:5: vertex weight line ends in blanks after its last field");
+        CHECK(parseObj(tri + "vw 0\n").triangleCount() == 1);
+        CHECK(parseObj(tri + "vw   \n").triangleCount() == 1);
+    }
     TEST_CASE("hard case: vertex normals of tiny and huge triangles have unit length") {
         // A triangle of size 1e-10 has a cross product of 1e-20, whose squared length is
         // subnormal: the normal came out of length 0.6 (found by fuzzing,

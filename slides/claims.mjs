@@ -8,7 +8,8 @@
 //   <!-- check: 03_aabb:slab_accuracy[robust]{ns/test} > 1.2 * 03_aabb:slab_accuracy[naive (slide]{ns/test} -->
 //
 // A reference is STEP:TABLE[ROW]{COLUMN}: the table with that id, the one row whose cells
-// (joined by spaces) contain ROW (of several, the one where ROW is whole cells), the cell
+// (joined by spaces) contain ROW (of several, the one where ROW is whole cells; "A & B"
+// names a row by two parts apart, e.g. a bias and a map size), the cell
 // of that column; STEP:facts{NAME} is a fact. Both
 // sides are numbers, references, or products and quotients of them; the operators are
 // ==, !=, <, <=, >, >=. Every `<!-- fact: STEP/NAME -->` placeholder of a measured step must
@@ -92,13 +93,15 @@ function resolve(step, table, row, column) {
   if (!t) throw new Error(`out/${step}.json has no table '${table}'`);
   const c = t.columns.indexOf(column);
   if (c < 0) throw new Error(`table ${step}:${table} has no column '${column}' (columns: ${t.columns.join(", ")})`);
-  let rows = t.rows.filter((cells) => cells.map(String).join(" ").includes(row || ""));
+  // "A & B": a row that holds both (cells apart from each other: a bias and a map size).
+  const parts = (row || "").split(" & ");
+  let rows = t.rows.filter((cells) => parts.every((p) => cells.map(String).join(" ").includes(p)));
   // A name inside another ("sah" in "sweep-sah", "bunny planes" in "bunny planes + corners"):
-  // the one row where it is whole cells, one cell or a run of them.
+  // the one row where each part is whole cells, one cell or a run of them.
   if (rows.length > 1) {
-    const whole = (cells) =>
-      cells.some((_, i) => cells.slice(i).some((__, j) => cells.slice(i, i + j + 1).map(String).join(" ") === row));
-    const exact = rows.filter(whole);
+    const whole = (cells, p) =>
+      cells.some((_, i) => cells.slice(i).some((__, j) => cells.slice(i, i + j + 1).map(String).join(" ") === p));
+    const exact = rows.filter((cells) => parts.every((p) => whole(cells, p)));
     if (exact.length === 1) rows = exact;
   }
   if (rows.length !== 1)
@@ -178,7 +181,7 @@ function main() {
 function selfTest() {
   const fixtures = path.join(path.dirname(here), "tests", "slides_claims");
   const cases = [
-    { root: "agree", status: 0, says: ["4 agree with the reports, 0 do not"] },
+    { root: "agree", status: 0, says: ["5 agree with the reports, 0 do not"] },
     { root: "contradict", status: 1, says: ["slides/01_fixture.md:4:", "the report says 1722 == 0"] },
     { root: "broken", status: 1, says: ["no column 'no such column'", "no fact 'no_such_fact'"] },
     { root: "agree", out: "agree", status: 77, says: ["0 agree", "not measured"] },

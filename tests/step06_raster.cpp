@@ -522,6 +522,15 @@ TEST_SUITE("raster vs ray tracer") {
         // Most of the map lies behind the eye or crosses the near plane.
         CHECK(a.stats.culledOutside + a.stats.clipped > a.stats.trianglesIn / 4);
     }
+    TEST_CASE("a named meshes folder is used for the interior map or refused without one") {
+        test::TempDir dir;
+        CHECK_THROWS_AS(findInteriorMap(dir.path.string()), InputError);
+        { std::ofstream(dir.file("oa_thor.obj")) << "v 0 0 0\nv 1 0 0\nv 0 1 0\nf 1 2 3\n"; }
+        std::string why = "unchanged";
+        std::string map = findInteriorMap(dir.path.string(), &why);
+        CHECK(std::filesystem::equivalent(map, dir.file("oa_thor.obj")));
+        CHECK(why == "unchanged");
+    }
     TEST_CASE("back-face culling changes nothing on a closed mesh seen from outside") {
         Scene s = makeScene("sh1", {test::dataDir(), 4.0f / 3.0f});
         RasterScene raster = RasterScene::fromScene(s);

@@ -163,7 +163,14 @@ def main(argv=None):
         print("Left out: %s" % line)
     load = os.getloadavg()[0]
     print("(load average during the run: %.1f on %d cores)" % (load, os.cpu_count()))
+    cpu = "unknown CPU"
+    try:
+        cpu = [l.split(":", 1)[1].strip() for l in open("/proc/cpuinfo")
+               if l.startswith("model name")][0]
+    except (OSError, IndexError):
+        pass
     report = {"program": "06_raster_bench", "images": [], "facts": {"load_average": load},
+              "machine": "%s, %d cores, load average %.1f" % (cpu, os.cpu_count(), load),
               "width": a.width, "height": a.height, "rounds": a.rounds, "repeat": a.repeat,
               "unavailable": unavailable, "rows": rows,
               "tables": [{

@@ -49,8 +49,13 @@ pkgs_for() {
       libtinyobjloader-dev libcli11-dev nlohmann-json3-dev
     ;;
   # openfoam-examples, openarena-088-data: the motorbike and the interior map
-  # (tools/bench/meshes.py); perf: step 05 README
-  bench) echo libbenchmark-dev libembree-dev openfoam-examples openarena-088-data linux-perf ;;
+  # (tools/bench/meshes.py); perf: step 05 README; libgl1-mesa-dri (Mesa's llvmpipe),
+  # libegl1 and libegl-mesa0 (EGL, through SDL's offscreen driver): the rasterizer row's
+  # OpenGL (tools/bench/raster_gl)
+  bench)
+    echo libbenchmark-dev libembree-dev openfoam-examples openarena-088-data linux-perf \
+      libgl1-mesa-dri libegl1 libegl-mesa0
+    ;;
   all) for g in "${groups[@]}"; do pkgs_for "$g"; done ;;
   *)
     echo "tools/deps.sh: unknown group '$1'" >&2

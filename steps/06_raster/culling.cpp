@@ -25,7 +25,16 @@ std::vector<uint32_t> FrustumCuller::visibleTriangles(const Camera& camera, doub
     stats.boxesVisited = counts.visited;
     stats.boxesCulled = counts.culled;
     stats.boxesKept = counts.kept;
-    std::sort(visible.begin(), visible.end());
+    // Back to file order through a mark per triangle: linear, where sorting the kept list
+    // cost more than the walk itself on a mesh seen whole.
+    std::vector<char> kept(bvh_.primitiveIndices.size(), 0);
+    for (uint32_t t : visible) {
+        if (t >= kept.size()) kept.resize(size_t(t) + 1, 0);
+        kept[t] = 1;
+    }
+    visible.clear();
+    for (size_t t = 0; t < kept.size(); ++t)
+        if (kept[t]) visible.push_back(uint32_t(t));
     stats.trianglesKept = visible.size();
     stats.milliseconds = watch.milliseconds();
     return visible;

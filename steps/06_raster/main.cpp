@@ -14,7 +14,7 @@ using namespace boxes;
 int main(int argc, char** argv) {
     CLI::Option *nearOption = nullptr, *farOption = nullptr;
     double nearFlag = 0.0, farFlag = 0.0;
-    std::string idsPath, depthPath, shadows = "rays";
+    std::string idsPath, depthPath, shadows = "rays", meshesDir;
     bool affine = false, compare = false, measure = false, noCull = false, floorTexture = false;
     std::optional<TexturedFloor> floor;  // with --floor-texture
     RasterSettings rs;
@@ -64,6 +64,9 @@ int main(int argc, char** argv) {
             "--compare", compare,
             "also ray trace the view and print how the two agree (and write FILE-diff.png)");
         app.add_flag("--measure", measure, "run the step's measurements and print the tables");
+        app.add_option("--meshes", meshesDir,
+                       "--measure: the folder of oa_thor.obj, the interior map (default: "
+                       "$BOXES_MESHES, else build/meshes/, made by tools/bench/meshes.py)");
     };
     // --floor-texture: the floor's scene and camera (the camera flags still apply).
     step.makeScene = [&](const CommonOptions& o) {
@@ -104,7 +107,7 @@ int main(int argc, char** argv) {
     step.measure = [&](StepRun& run, Report& report) {
         if (compare) compareWithRayTracer(run, view, frame, report);
         if (compare && floor) compareTextureWithRayTracer(run, *floor, view, frame, report);
-        if (measure) measureRaster(run, report);
+        if (measure) measureRaster(run, report, meshesDir);
     };
 
     // The window: rasterizer, ray tracer, or their difference (viewer.hpp).

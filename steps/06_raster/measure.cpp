@@ -42,16 +42,43 @@ void attachGrid(Scene& scene) {
         scene.geometries.push_back(std::make_shared<TriangleGrid>(scene.mesh, scene.meshMaterial));
 }
 
-std::string findSharedMeshes() {
-    const char* env = std::getenv("BOXES_MESHES");
-    if (!env || !*env) return "";
+std::string findInteriorMap(const std::string& folder, std::string* why) {
+    namespace fs = std::filesystem;
+    std::string named = folder;
+    if (named.empty()) {
+        const char* env = std::getenv("BOXES_MESHES");
+        if (env && *env) named = env;
+    }
     std::error_code ec;
-    if (!std::filesystem::exists(std::filesystem::path(env) / "oa_thor.obj", ec))
-        throw InputError("BOXES_MESHES=" + printable(env) + ": no oa_thor.obj in that folder");
-    return std::filesystem::weakly_canonical(env, ec).string();
+    if (!named.empty()) {
+        fs::path obj = fs::path(named) / "oa_thor.obj";
+        if (!fs::exists(obj, ec))
+            throw InputError("--meshes/BOXES_MESHES " + printable(named) +
+                             ": no oa_thor.obj in that folder");
+        return fs::weakly_canonical(obj, ec).string();
+    }
+    const fs::path cache = BOXES_MESH_CACHE, tool = BOXES_MESH_TOOL;
+    const fs::path obj = cache / "oa_thor.obj";
+    // meshes.py checks the cached file's provenance against the package's version and
+    // converts the map when it is missing or stale (about 2 s); exit code 3: no package.
+    if (fs::exists(tool, ec) && (tool.string() + cache.string()).find('\'') == std::string::npos) {
+        std::string command = "python3 '" + tool.string() + "' oa_thor --cache '" + cache.string() +
+                              "' >/dev/null 2>&1";
+        int rc = std::system(command.c_str());
+        if (rc == 0 && fs::exists(obj, ec)) return obj.string();
+        if (why)
+            *why =
+                "the interior map cannot be made (Debian's openarena-088-data: "
+                "tools/deps.sh bench installs it; then " +
+                tool.string() + " oa_thor makes " + obj.string() + ")";
+        return "";
+    }
+    if (fs::exists(obj, ec)) return obj.string();
+    if (why) *why = "no " + obj.string() + " and no " + tool.string() + " to make it";
+    return "";
 }
 
-std::vector<MeasureView> measureViews(const std::string& dataDir, const std::string& sharedMeshes,
+std::vector<MeasureView> measureViews(const std::string& dataDir, const std::string& interiorMap,
                                       float aspect) {
     std::vector<MeasureView> views;
     SceneOptions options{dataDir, aspect};
@@ -65,8 +92,8 @@ std::vector<MeasureView> measureViews(const std::string& dataDir, const std::str
         v.camera = v.scene.camera;
         views.push_back(std::move(v));
     }
-    if (!sharedMeshes.empty()) {
-        MeasureView v{"oa_thor (inside)", makeScene(sharedMeshes + "/oa_thor.obj", options), {}};
+    if (!interiorMap.empty()) {
+        MeasureView v{"oa_thor (inside)", makeScene(interiorMap, options), {}};
         v.camera =
             Camera::lookingAt(Vec3(960, -384, 2), Vec3(960, 600, 2), Vec3(0, 0, 1), 90.0f, aspect);
         views.push_back(std::move(v));
@@ -591,12 +618,15 @@ void compareTextureWithRayTracer(const StepRun& run, const TexturedFloor& floor,
         c.floorPixels, c.colourDiffering, c.maxTexcoordError);
 }
 
-void measureRaster(const StepRun& run, Report& report) {
+void measureRaster(const StepRun& run, Report& report, const std::string& meshes) {
     MeasureSettings ms;
     ms.width = run.options.width;
     ms.height = run.options.height;
     const CommonOptions& o = run.options;
-    std::vector<MeasureView> views = measureViews(o.dataDir, findSharedMeshes(), o.aspect());
+    std::string why;
+    const std::string interior = findInteriorMap(meshes, &why);
+    if (interior.empty()) std::cerr << "06_raster: the interior map left out: " << why << "\n";
+    std::vector<MeasureView> views = measureViews(o.dataDir, interior, o.aspect());
     report.add(measureVisibility(views, ms));
     report.add(measureFrameTimes(views, ms));
     report.add(measureCulling(views, ms));

@@ -27,15 +27,17 @@ struct MeasureView {
 // The scene with step 01's TriangleGrid as the mesh's geometry (the ray tracer's view of it).
 void attachGrid(Scene& scene);
 
-// The built-in views: the bunny and sh1 from outside, and oa_thor from inside when
-// `sharedMeshes` (a folder, see findSharedMeshes) is not empty.
-std::vector<MeasureView> measureViews(const std::string& dataDir, const std::string& sharedMeshes,
+// The built-in views: the bunny and sh1 from outside, and the interior map from inside when
+// `interiorMap` (its OBJ file, see findInteriorMap) is not empty.
+std::vector<MeasureView> measureViews(const std::string& dataDir, const std::string& interiorMap,
                                       float aspect);
 
-// The folder of the larger meshes that the workbook does not ship (oa_thor.obj), named by
-// the environment variable BOXES_MESHES; empty when it is not set. Throws InputError when
-// it is set but holds no oa_thor.obj.
-std::string findSharedMeshes();
+// The interior map oa_thor.obj, which the workbook does not ship: in `folder` when one is
+// named (--meshes DIR, else the environment variable BOXES_MESHES), else in the workbook's
+// mesh cache (build/meshes/), which tools/bench/meshes.py fills on first use from Debian's
+// openarena-088-data. Returns "" when it cannot be had, with the reason in `why`; throws
+// InputError when a named folder holds no oa_thor.obj.
+std::string findInteriorMap(const std::string& folder, std::string* why = nullptr);
 
 struct MeasureSettings {
     int width = 640, height = 480;
@@ -83,7 +85,8 @@ struct TexturedFloor;
 void compareTextureWithRayTracer(const StepRun& run, const TexturedFloor& floor,
                                  const RasterView& view, const RasterFrame& frame, Report& report);
 
-// The program's --measure: every table above at the image's size, with the bias plot.
-void measureRaster(const StepRun& run, Report& report);
+// The program's --measure: every table above at the image's size, with the bias plot;
+// `meshes`: the folder of oa_thor.obj (see findInteriorMap).
+void measureRaster(const StepRun& run, Report& report, const std::string& meshes = "");
 
 }  // namespace boxes

@@ -163,3 +163,24 @@ def mesh_path(name, cache, data=None):
     if name == "oa_thor":
         return oa_thor(cache)
     raise Unavailable("%s: no such mesh (bunny, sh1, motorbike, oa_thor)" % name)
+
+
+def main(argv=None):
+    """python3 tools/bench/meshes.py MESH [--cache DIR]: prints the OBJ's path, converting it
+    into the cache first when needed; exit code 3 (and why on stderr) when it cannot be had."""
+    import argparse
+    import sys
+    ap = argparse.ArgumentParser(description="the path of a bench mesh, made on first use")
+    ap.add_argument("mesh", help="bunny, sh1, motorbike or oa_thor")
+    ap.add_argument("--cache", default=os.path.join(ROOT, "build", "meshes"))
+    a = ap.parse_args(argv)
+    try:
+        print(mesh_path(a.mesh, a.cache))
+    except Unavailable as e:
+        print("meshes.py: %s" % e, file=sys.stderr)
+        return 3
+    return 0
+
+
+if __name__ == "__main__":
+    raise SystemExit(main())

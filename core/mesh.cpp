@@ -227,6 +227,12 @@ void checkLines(std::string_view text, const std::string& name, const ObjLimits&
                     throw InputError(name + ": more than " + std::to_string(limits.triangles) +
                                      " triangles (the limit)");
             }
+            // tinyobjloader reads a line or point element after the keyword's blank without
+            // skipping further blanks: with none but blanks it reads index 0 and refuses the
+            // file, with none at all it keeps an empty one (found by the fuzz target's strict
+            // reader). An element that names no vertex is refused either way.
+            else if (fields.empty())
+                throw InputError(where() + "a '" + std::string(1, line[0]) + "' line names no vertex");
             for (std::string_view field : fields) checkIndexToken(field, counts, where());
         } else if (keyword("s")) {
             auto fields = splitFields(line.substr(2), 2);

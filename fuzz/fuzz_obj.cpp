@@ -88,6 +88,7 @@ std::optional<std::vector<Triangle>> strictRead(std::string_view text) {
             ++vn;
         } else if (key == "f" || key == "l" || key == "p") {
             if (key == "f" && (args.size() < 3 || args.size() > 255)) return std::nullopt;
+            if (key != "f" && args.empty()) return std::nullopt;
             std::vector<uint32_t> corners;
             for (std::string_view token : args) {
                 std::vector<std::string_view> parts = split(token, "/");

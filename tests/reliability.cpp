@@ -142,6 +142,16 @@ TEST_SUITE("hard cases reliability") {
         CHECK(refusal(tri + "vw 0 1 x\n") == "x.obj:5: vertex weight field 'x' is not a number");
         CHECK(parseObj(tri + "vw 0 1 0.5 2 -0.25\n").triangleCount() == 1);
     }
+    TEST_CASE("hard case: an OBJ line or point element that names no vertex is refused with its line") {
+        // tinyobjloader refused 'l' followed by blanks only as "zero value for vertex index"
+        // and kept 'l' alone as an empty element (found by the fuzz target's strict reader,
+        // fuzz/corpus/obj/crash-690497...).
+        const std::string tri = "v 0 0 0\nv 1 0 0\nv 0 1 0\nf 1 2 3\n";
+        CHECK(refusal(tri + "l  \n") == "x.obj:5: a 'l' line names no vertex");
+        CHECK(refusal(tri + "p \n") == "x.obj:5: a 'p' line names no vertex");
+        CHECK(parseObj(tri + "l 1 2\np 3\n").triangleCount() == 1);
+        CHECK(parseObj(tri + "l  1 2\n").triangleCount() == 1);
+    }
     TEST_CASE("hard case: an OBJ vertex weight line that ends in blanks is refused with its line") {
         // tinyobjloader reads one more joint after a trailing blank, finds none and refused
         // the file with "joint_id is negative" (found by the fuzz target's strict reader,

@@ -284,6 +284,11 @@ uint32_t traverseNearest4Leaves(const BvhWide<W>& bvh, const TraversalRay& trave
     for (;;) {
         if (count == 0) {
             const BvhWideNode<W>& node = nodes[child];
+#if defined(__SSE2__)
+            // The children's indices lie on the node's last line, read only after the box
+            // test: asked for now, their fetch overlaps the test.
+            _mm_prefetch(reinterpret_cast<const char*>(node.child), _MM_HINT_T0);
+#endif
             nodeCount.node();
             alignas(32) float t[W];
             int mask = intersectChildBoundsFor<kAvx>(node, ray, tClosest, t);

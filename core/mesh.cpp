@@ -185,7 +185,12 @@ void checkIndexToken(std::string_view token, const ObjCounts& counts, const std:
     }
 }
 
-void checkLines(std::string_view text, const std::string& name, const ObjLimits& limits) {
+// Returns the vertices' coordinates as it read them (std::from_chars: correctly rounded),
+// which the mesh keeps instead of tinyobjloader's own reading: that one multiplies by
+// pow(10, exponent) and made 0e3800 NaN (found by the fuzz target's strict reader).
+std::vector<Vec3> checkLines(std::string_view text, const std::string& name,
+                             const ObjLimits& limits) {
+    std::vector<Vec3> positions;
     size_t lineNumber = 0, triangles = 0;
     ObjCounts counts;
     size_t pos = 0;
@@ -246,8 +251,10 @@ void checkLines(std::string_view text, const std::string& name, const ObjLimits&
             throw InputError(where() + "tag lines ('t') are not read by the workbook");
         } else if (keyword("v")) {
             auto fields = splitFields(line.substr(2), 3);
-            for (std::string_view field : fields) {
-                float value = 0.0f;
+            float xyz[3] = {0.0f, 0.0f, 0.0f};
+            for (size_t k = 0; k < fields.size(); ++k) {
+                std::string_view field = fields[k];
+                float& value = xyz[k];
                 const char* fieldEnd = field.data() + field.size();
                 auto [ptr, ec] = std::from_chars(field.data(), fieldEnd, value);
                 std::string shown = printable(field, 40);
@@ -262,8 +269,10 @@ void checkLines(std::string_view text, const std::string& name, const ObjLimits&
             if (++counts.vertices > limits.vertices)
                 throw InputError(name + ": more than " + std::to_string(limits.vertices) +
                                  " vertices (the limit)");
+            positions.emplace_back(xyz[0], xyz[1], xyz[2]);
         }
     }
+    return positions;
 }
 
 std::string firstLine(const std::string& s) {
@@ -278,7 +287,7 @@ std::string firstLine(const std::string& s) {
 Mesh parseObj(const std::string& text, const std::string& name, const ObjLimits& limits) {
     if (text.find_first_not_of(" \t\r\n") == std::string::npos)
         throw InputError(name + ": the file is empty");
-    checkLines(text, name, limits);
+    std::vector<Vec3> positions = checkLines(text, name, limits);
 
     // No material reader: tinyobjloader then skips "mtllib" lines, so a path an OBJ file
     // names is never opened (the workbook's materials come from the scene, not the file).
@@ -294,10 +303,10 @@ Mesh parseObj(const std::string& text, const std::string& name, const ObjLimits&
         throw InputError(name + ": " + firstLine(error.empty() ? "cannot parse" : error));
     Mesh mesh;
     size_t vertexCount = attrib.vertices.size() / 3;
-    mesh.positions.reserve(vertexCount);
-    for (size_t i = 0; i < vertexCount; ++i)
-        mesh.positions.emplace_back(attrib.vertices[3 * i], attrib.vertices[3 * i + 1],
-                                    attrib.vertices[3 * i + 2]);
+    if (vertexCount != positions.size())
+        throw InputError(name + ": cannot parse (" + std::to_string(vertexCount) +
+                         " vertices read, " + std::to_string(positions.size()) + " v lines)");
+    mesh.positions = std::move(positions);
     for (const auto& shape : shapes) {
         size_t offset = 0;
         for (unsigned char faceSize : shape.mesh.num_face_vertices) {

@@ -1,5 +1,6 @@
 // Step 05: the lab's exercises with checked numbers, the incremental renderer against an
 // injected clock, effects on demand, and the program.
+#include <algorithm>
 #include <cmath>
 #include <cstring>
 #include <filesystem>
@@ -184,7 +185,8 @@ void checkEffectsIdentity(const Scene& scene, int w, int h, int maxDepth, uint64
 // the shadow ray of a light that would light the point, the traced ray must be unblocked.
 // An occluder the analysis drops wrongly shows here even where the image hides it.
 // Returns the number of skipped shadow rays checked.
-int checkAnalysisSound(const Scene& scene, uint64_t seed) {
+int checkAnalysisSound(const RandomScene& random, uint64_t seed) {
+    const Scene& scene = random.scene;
     std::mt19937_64 rng(seed);
     std::uniform_real_distribution<float> u(-6.0f, 6.0f);
     RenderSettings s;
@@ -216,6 +218,29 @@ int checkAnalysisSound(const Scene& scene, uint64_t seed) {
         }
     }
     CHECK(unsound == 0);
+    // The lists themselves: an object left out for a light has no point in the light's
+    // ball (a sphere's nearest point, a mesh's vertices), within float rounding.
+    int leftOutWrongly = 0;
+    for (size_t i = 0; i < scene.lights.size(); ++i) {
+        const PointLight& light = scene.lights[i];
+        const std::vector<int>& list = renderer.analysis().occluders[i];
+        auto outside = [&](float distance) { return distance > light.radius * (1.0f - 1e-4f); };
+        auto listed = [&](int object) {
+            return std::find(list.begin(), list.end(), object) != list.end();
+        };
+        int object = 0;
+        for (const auto& sphere : scene.spheres) {
+            float gap = glm::length(light.position - sphere.shape.centre) - sphere.shape.radius;
+            leftOutWrongly += !listed(object++) && !outside(gap);
+        }
+        object += int(scene.planes.size());
+        for (const auto& mesh : random.meshes) {  // the first geometries, in order
+            if (!listed(object++))
+                for (const Vec3& p : mesh->positions)
+                    leftOutWrongly += !outside(glm::length(p - light.position));
+        }
+    }
+    CHECK(leftOutWrongly == 0);
     return checked;
 }
 
@@ -773,7 +798,7 @@ TEST_SUITE("renderer 05") {
             const Scene& scene = random.scene;
             INFO("random scene " << i);
             checkEffectsIdentity(scene, 20, 15, 1 + i % 5, uint64_t(i));
-            skipsChecked += checkAnalysisSound(scene, uint64_t(i));
+            skipsChecked += checkAnalysisSound(random, uint64_t(i));
             RenderSettings s;
             s.width = 20;
             s.height = 15;

@@ -71,10 +71,12 @@ public:
 
     const SceneAnalysis& analysis() const { return analysis_; }
     const RenderSettings& settings() const { return settings_; }
+    // The analysis' decision for a lit point: false when no object can block the light
+    // there (its shadow ray is skipped). Public so that the tests can check it is sound.
+    bool needsShadowRay(int light, const SurfaceHit& hit) const;
 
 private:
     Vec3 shade(const Ray& ray, const SurfaceHit& hit, int depth, RayCounts& counts) const;
-    bool needsShadowRay(int light, const SurfaceHit& hit) const;
 
     const Scene& scene_;
     Camera camera_;

@@ -4,6 +4,7 @@
 #include <cfenv>
 #include <chrono>
 #include <cmath>
+#include <functional>
 #include <stdexcept>
 #include <thread>
 #include <vector>
@@ -277,5 +278,47 @@ TEST_SUITE("renderer") {
         scene.mesh = parseObj("v 0 0 0\nv 1 0 0\nv 0 1 0\nf 1 2 3\n");
         RenderSettings s;
         CHECK_THROWS_AS(renderImage(scene, scene.camera, s), std::logic_error);
+    }
+}
+
+// The check every step's "program NN" suite runs on its JSON report (test::checkVariantTables)
+// on a small fixture: sound as written, and a problem for each column taken away.
+TEST_SUITE("core") {
+    TEST_CASE("variant tables: the check fails on a table without its time or its error column") {
+        const nlohmann::json sound = nlohmann::json::parse(R"({"tables": [{
+            "id": "t", "note": "error: pixels differing from the double-precision image",
+            "columns": ["variant", "median ms", "low ms", "high ms", "pixels differing"],
+            "time": {"median": "median ms", "low": "low ms", "high": "high ms"},
+            "error": "pixels differing",
+            "rows": [["float", 1.0, 0.9, 1.2, 3], ["double", 2.5, 2.4, 2.7, 0]]}]})");
+        CHECK(test::variantTableProblems(sound, {"t"}).empty());
+        auto problems = [&](const std::function<void(nlohmann::json&)>& edit) {
+            nlohmann::json report = sound;
+            edit(report["tables"][0]);
+            return test::variantTableProblems(report, {"t"});
+        };
+        using Problems = std::vector<std::string>;
+        CHECK(problems([](nlohmann::json& t) { t.erase("time"); }) ==
+              Problems{"t: no time column"});
+        CHECK(problems([](nlohmann::json& t) { t.erase("error"); }) ==
+              Problems{"t: no error column"});
+        CHECK(problems([](nlohmann::json& t) {
+                  t.erase("time");
+                  t.erase("error");
+              }) == Problems{"t: no time column", "t: no error column"});
+        // The column named but gone from the columns, or from a row.
+        CHECK(problems([](nlohmann::json& t) { t["columns"][4] = "error"; }) ==
+              Problems{"t: no column \"pixels differing\""});
+        CHECK(problems([](nlohmann::json& t) { t["columns"][2] = "min ms"; }) ==
+              Problems{"t: no column \"low ms\""});
+        CHECK(problems([](nlohmann::json& t) { t["rows"][1].erase(4); }).size() == 1);
+        CHECK(problems([](nlohmann::json& t) { t["rows"][0][4] = nullptr; }).size() == 1);
+        // A median outside its spread, no note, no rows, no table.
+        CHECK(problems([](nlohmann::json& t) { t["rows"][0][1] = 5.0; }).size() == 1);
+        CHECK(problems([](nlohmann::json& t) { t.erase("note"); }) ==
+              Problems{"t: no note stating the reference"});
+        CHECK(problems([](nlohmann::json& t) { t["rows"] = nlohmann::json::array(); }) ==
+              Problems{"t: no rows"});
+        CHECK(test::variantTableProblems(sound, {"t", "u"}) == Problems{"u: no such table"});
     }
 }

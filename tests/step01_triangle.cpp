@@ -495,6 +495,60 @@ TEST_SUITE("hard cases 01") {
             CHECK_FALSE(intersectTriangle(test, ray, cast<float>(kUnit)));
         }
     }
+    TEST_CASE("hard case: no self-intersection acne on meshes at scene scales 1 to 1e5") {
+        // A convex mesh (a latitude-longitude sphere of 12 x 24 planar quads, each two
+        // triangles) cannot shadow a point of a face that looks at the light: such a point
+        // and the light are both outside that face's plane, the mesh inside it. A shadow
+        // ray from the renderer's offset origin (offsetOrigin) that hits the mesh again is
+        // acne; a fixed offset falls below float's spacing at 1e5.
+        constexpr int rings = 12, segments = 24;
+        for (float scale : {1.0f, 10.0f, 100.0f, 1e3f, 1e4f, 1e5f}) {
+            const Vec3 centre = Vec3(0.2f, -0.1f, -3.0f) * scale, light = Vec3(5.0f) * scale;
+            auto vertex = [&](int ring, int segment) {
+                float theta = kPi * float(ring) / rings,
+                      phi = 2.0f * kPi * float(segment) / segments;
+                return centre + scale * Vec3(std::sin(theta) * std::cos(phi), std::cos(theta),
+                                             std::sin(theta) * std::sin(phi));
+            };
+            std::vector<Triangle> mesh;
+            for (int r = 0; r < rings; ++r)
+                for (int k = 0; k < segments; ++k) {
+                    Vec3 a = vertex(r, k), b = vertex(r, k + 1), c = vertex(r + 1, k),
+                         d = vertex(r + 1, k + 1);
+                    if (r > 0) mesh.push_back({a, b, d});  // the poles' quads are triangles
+                    if (r < rings - 1) mesh.push_back({a, d, c});
+                }
+            auto nearest = [&](const Ray& ray, int& which) {
+                std::optional<float> best;
+                for (size_t i = 0; i < mesh.size(); ++i)
+                    if (auto h = intersectWatertight(ray, mesh[i]); h && (!best || h->t < *best))
+                        best = h->t, which = int(i);
+                return best;
+            };
+            int lit = 0, acne = 0;
+            for (int y = 0; y < 40; ++y)
+                for (int x = 0; x < 40; ++x) {
+                    Vec3 target =
+                        centre + scale * Vec3((x - 19.5f) / 20.0f, (y - 19.5f) / 20.0f, 0.0f);
+                    Ray ray(Vec3(0.0f), target);
+                    int face = -1;
+                    auto t = nearest(ray, face);
+                    if (!t) continue;
+                    const Triangle& f = mesh[size_t(face)];
+                    Vec3 p = ray.at(*t), n = glm::normalize(glm::cross(f.b - f.a, f.c - f.a));
+                    if (glm::dot(n, (f.a + f.b + f.c) / 3.0f - centre) < 0.0f) n = -n;  // outward
+                    Vec3 toLight = light - p;
+                    if (glm::dot(n, toLight) <= 0.0f) continue;
+                    ++lit;
+                    Ray shadow(offsetOrigin(p, n, toLight), toLight, 0.0f, 1.0f);
+                    int ignored = -1;
+                    acne += nearest(shadow, ignored).has_value();
+                }
+            INFO("scale " << scale << ": " << lit << " lit points");
+            CHECK(lit > 300);
+            CHECK(acne == 0);
+        }
+    }
     TEST_CASE("hard case: grazing rays nearly parallel to a triangle hit it where double does") {
         // Slopes from 1e-3 down to 1e-30 against the plane z = 0: D.N is tiny but not 0,
         // so the ray meets the plane at x = 0.25. An epsilon on the determinant (|det| <

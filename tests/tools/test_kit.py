@@ -117,6 +117,8 @@ class KitContents(unittest.TestCase):
         # The mistakes' catalogue patches the solutions: it stays out with its runner.
         self.assertIn("tools/grading/mutants.py", kit.NOT_IN_KIT)
         self.assertFalse(kit.in_kit("tests/mutants/1.4-no-v-rejection.patch"))
+        self.assertIn("tools/grading/safeguards.py", kit.NOT_IN_KIT)
+        self.assertFalse(kit.in_kit("tests/safeguards/offset-scales.patch"))
         self.assertTrue(kit.in_kit("tests/hints/mistakes.json"))
 
     def test_a_written_kit_has_no_mutant_patches(self):

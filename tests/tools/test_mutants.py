@@ -1,6 +1,9 @@
 """Tests of tools/grading/mutants.py: the catalogue of students' mistakes (tests/mutants) is
 sound (every patch applies to the reference, names its test case, and has that case's hint),
-and the runner's pieces work on a small tree. The slow run itself is the ctest label mutants."""
+and the runner's pieces work on a small tree. The same for the catalogue of the hard cases'
+safeguards (tests/safeguards, tools/grading/safeguards.py): every patch applies and names
+test cases that exist. The slow runs themselves are the ctest label mutants and
+./workbook mutants --safeguards."""
 import json
 import os
 import subprocess
@@ -10,7 +13,7 @@ import unittest
 
 ROOT = os.path.dirname(os.path.dirname(os.path.dirname(os.path.abspath(__file__))))
 sys.path.insert(0, ROOT)
-from tools.grading import mutants  # noqa: E402
+from tools.grading import mutants, safeguards  # noqa: E402
 
 PATCH = """Mistake: a + b written a - b
 Caught by: sum: worked values
@@ -113,6 +116,90 @@ class Pieces(unittest.TestCase):
         self.assertIn("caught", lines[1])
         self.assertIn("a case", lines[1])
         self.assertTrue(lines[2].rstrip().endswith("-"))
+
+
+SAFEGUARD = """Safeguard: a sum adds
+Caught by: hard case: sums
+
+diff --git a/steps/01_x/x.cpp b/steps/01_x/x.cpp
+--- a/steps/01_x/x.cpp
++++ b/steps/01_x/x.cpp
+@@ -1,3 +1,3 @@
+ float sum(float a, float b) {
+-    return a + b;
++    return a - b;
+ }
+"""
+
+
+def safeguard_tree(patch=SAFEGUARD, tests=None):
+    root = small_tree()
+    files = {"tests/safeguards/sum-adds.patch": patch,
+             "tests/step01_x.cpp": tests or 'TEST_CASE("hard case: sums") {}\n',
+             "tests/hard_cases.cpp": 'TEST_CASE("hard case: far") {}\n'}
+    for rel, text in files.items():
+        os.makedirs(os.path.dirname(os.path.join(root, rel)), exist_ok=True)
+        with open(os.path.join(root, rel), "w") as f:
+            f.write(text)
+    return root
+
+
+class TheSafeguards(unittest.TestCase):
+    def test_every_patch_applies_and_names_cases_that_exist(self):
+        problems = safeguards.check_catalogue(ROOT)
+        self.assertEqual(problems, [], "\n".join(problems))
+
+    def test_the_catalogue_covers_the_named_hard_cases_and_the_analysis(self):
+        cases = {c.split(": ", 1)[-1] if c.startswith("test_") else c
+                 for s in safeguards.catalogue(ROOT) for c in s.caught_by}
+        for wanted in ("hard case: a triangle 1e21 across straight ahead is hit",
+                       "hard case: grazing rays nearly parallel to a triangle hit it where double does",
+                       "hard case: no self-intersection acne on spheres at scene scales 1 to 1e5",
+                       "hard case: no self-intersection acne on meshes at scene scales 1 to 1e5",
+                       "hard case: light does not leak through a closed thin wall at scales 1 to 1e5",
+                       "hard case: spheres 1e4 and 1e5 from the origin are hit and missed as in double",
+                       "hard case: a ray touching a sphere tangentially hits it once at the tangent point",
+                       "hard case: a ray starting on a sphere finds the far side or nothing",
+                       "effects on demand: 200 random scenes bit-identical with fewer or equal rays"):
+            self.assertIn(wanted, cases)
+        tmin = [c for c in cases if "t == tmin" in c]
+        self.assertGreaterEqual(len(tmin), 4, tmin)  # triangles, spheres and planes, boxes, slabs
+
+    def test_the_header_and_the_programs(self):
+        root = safeguard_tree()
+        [s] = safeguards.catalogue(root)
+        self.assertEqual((s.id, s.safeguard, s.caught_by), ("sum-adds", "a sum adds", ["hard case: sums"]))
+        self.assertEqual(safeguards.check_catalogue(root), [])
+        where = safeguards.case_programs(root)
+        self.assertEqual(where["hard case: sums"], {"test_step01"})
+        self.assertEqual(where["hard case: far"], {"test_core"})
+        self.assertEqual(safeguards.named_cases(s, where), [("test_step01", "hard case: sums")])
+
+    def test_a_stale_patch_an_unknown_and_an_ambiguous_case_are_problems(self):
+        root = safeguard_tree(SAFEGUARD.replace("return a + b", "return a * b"))
+        self.assertTrue(any("does not apply" in p for p in safeguards.check_catalogue(root)))
+        root = safeguard_tree(SAFEGUARD.replace("Caught by: hard case: sums", "Caught by: no such case"))
+        self.assertIn("sum-adds: no test case named 'no such case'", safeguards.check_catalogue(root))
+        both = 'TEST_CASE("hard case: far") {}\n'
+        root = safeguard_tree(SAFEGUARD.replace("hard case: sums", "hard case: far"), both)
+        self.assertTrue(any("name its program" in p for p in safeguards.check_catalogue(root)))
+        # Named with its program, the shared name is no problem.
+        root = safeguard_tree(SAFEGUARD.replace("hard case: sums", "test_core: hard case: far"), both)
+        self.assertEqual(safeguards.check_catalogue(root), [])
+
+    def test_the_tests_run_and_the_verdict(self):
+        listed = {"test_step01: hard case: sums": 1, "test_step01: other": 2,
+                  "test_step01: effects: random": 3, "test_core: hard case: far": 4}
+        named = [("test_step01", "effects: random")]
+        self.assertEqual(safeguards.chosen_tests(listed, named),
+                         {"test_step01: hard case: sums": 1, "test_step01: effects: random": 3})
+        self.assertEqual(safeguards.verdict(named, "failed", ["test_step01: effects: random"]), "proven")
+        self.assertEqual(safeguards.verdict(named, "passed", []), "MISSED")
+        self.assertEqual(safeguards.verdict(named, "failed", ["test_step01: hard case: sums"]),
+                         "named case passes")
+        self.assertEqual(safeguards.verdict(named, "failed", ["test_step01: effects: random",
+                                                              "test_step01: hard case: sums"]),
+                         "other hard cases fail too")
 
 
 if __name__ == "__main__":

@@ -11,10 +11,13 @@ student is in tests/hints/mistakes.json under the same name. The patches hold so
 the starter kit leaves them out (kit.py), and this command runs in the reference tree only.
 
 usage: ./workbook mutants [N.M | NN | N.M-name ...] [--list] [--check]
+       ./workbook mutants --safeguards [NAME ...] [--list] [--check]
   (none: every mutant; N.M: an exercise's; NN: a step's; N.M-name: one mutant, in the
   order given)
   --list   the catalogue
   --check  only check the catalogue: every patch applies, names its case, has a hint
+  --safeguards  the hard cases' safeguards removed instead (tests/safeguards,
+           tools/grading/safeguards.py): exactly the named hard cases must fail
 
 Each mutant is applied to a private copy of the tree (build/mutants/tree, kept between
 runs so that its build is incremental), the exercise's test program alone is built, the
@@ -281,6 +284,9 @@ def table(rows):
 
 
 def main(argv):
+    if "--safeguards" in argv:
+        from . import safeguards
+        return safeguards.main(argv)
     args = [a for a in argv if not a.startswith("-")]
     flags = [a for a in argv if a.startswith("-")]
     for f in flags:

@@ -9,6 +9,7 @@
 #include <fstream>
 #include <limits>
 #include <nlohmann/json.hpp>
+#include <optional>
 #include <sstream>
 #include <string>
 #include <vector>
@@ -28,6 +29,62 @@ struct StringMaker<glm::vec<L, T, Q>> {
         for (glm::length_t i = 0; i < L; ++i) s << (i ? ", " : "") << +v[i];
         s << ")";
         return String(s.str().c_str());
+    }
+};
+
+namespace detail {
+// The hits and intervals the steps return, known by their fields' names: this header
+// includes no step's header.
+template <typename T>
+concept StepResult = requires(const T& y) {
+    y.t, y.primitive, y.point;
+}
+|| requires(const T& y) {
+    y.t, y.triangle;
+}
+|| requires(const T& y) {
+    y.t, y.u, y.v;
+}
+|| requires(const T& y) {
+    y.t, y.normal, y.face, y.entering;
+}
+|| requires(const T& y) {
+    y.tnear, y.tfar;
+}
+|| requires(const T& y) {
+    y.normal, y.d;
+};
+}  // namespace detail
+
+// A failing CHECK on a hit, an interval or a plane prints its fields ("{t = 2, u = 0.2,
+// v = 0.3}") instead of {?}.
+template <detail::StepResult T>
+struct StringMaker<T> {
+    static String convert(const T& x) {
+        String fields;
+        if constexpr (requires { x.t, x.primitive, x.point; })
+            fields = "t = " + toString(x.t) + ", primitive " + toString(x.primitive) + " at " +
+                     toString(x.point) + ", u = " + toString(x.u) + ", v = " + toString(x.v);
+        else if constexpr (requires { x.t, x.triangle; })
+            fields = "t = " + toString(x.t) + ", triangle " + toString(x.triangle);
+        else if constexpr (requires { x.t, x.u, x.v; })
+            fields = "t = " + toString(x.t) + ", u = " + toString(x.u) + ", v = " + toString(x.v);
+        else if constexpr (requires { x.t, x.normal, x.face, x.entering; })
+            fields = "t = " + toString(x.t) + ", face " + toString(x.face) + ", normal " +
+                     toString(x.normal) + (x.entering ? ", entering" : ", leaving");
+        else if constexpr (requires { x.tnear, x.tfar; })
+            fields = "tnear = " + toString(x.tnear) + ", tfar = " + toString(x.tfar);
+        else
+            fields = "normal " + toString(x.normal) + ", d = " + toString(x.d);
+        return "{" + fields + "}";
+    }
+};
+
+// A result that may be absent says which: "nullopt", or its value.
+template <typename T>
+struct StringMaker<std::optional<T>> {
+    static String convert(const std::optional<T>& v) {
+        return v ? toString(*v) : String("nullopt");
     }
 };
 }  // namespace doctest

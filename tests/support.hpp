@@ -53,10 +53,13 @@ concept StepResult = requires(const T& y) {
 }
 || requires(const T& y) {
     y.normal, y.d;
+}
+|| requires(const T& y) {
+    y.min, y.max;
 };
 }  // namespace detail
 
-// A failing CHECK on a hit, an interval or a plane prints its fields ("{t = 2, u = 0.2,
+// A failing CHECK on a hit, an interval, a plane or a box prints its fields ("{t = 2, u = 0.2,
 // v = 0.3}") instead of {?}.
 template <detail::StepResult T>
 struct StringMaker<T> {
@@ -74,8 +77,10 @@ struct StringMaker<T> {
                      toString(x.normal) + (x.entering ? ", entering" : ", leaving");
         else if constexpr (requires { x.tnear, x.tfar; })
             fields = "tnear = " + toString(x.tnear) + ", tfar = " + toString(x.tfar);
-        else
+        else if constexpr (requires { x.normal, x.d; })
             fields = "normal " + toString(x.normal) + ", d = " + toString(x.d);
+        else
+            fields = "min " + toString(x.min) + ", max " + toString(x.max);
         return "{" + fields + "}";
     }
 };

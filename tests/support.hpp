@@ -96,9 +96,11 @@ struct StringMaker<std::optional<T>> {
 
 namespace boxes::test {
 
-inline std::string dataDir() {
-    return BOXES_TEST_DATA;
-}
+// The tree's data/ (test_main.cpp) and, in a step's test program, the step's program (a file
+// tests/CMakeLists.txt generates): paths outside the test files, which compile the same in
+// every tree.
+std::string dataDir();
+std::string stepProgram();
 
 // A fresh folder under the system's temporary directory, removed at scope exit.
 struct TempDir {

@@ -85,6 +85,18 @@ struct StringMaker<T> {
     }
 };
 
+// A list (the triangles a traversal tested, say) prints its first elements: "{0, 1}".
+template <typename T, typename A>
+struct StringMaker<std::vector<T, A>> {
+    static String convert(const std::vector<T, A>& v) {
+        constexpr size_t kShown = 20;
+        String s = "{";
+        for (size_t i = 0; i < v.size() && i < kShown; ++i) s += (i ? ", " : "") + toString(v[i]);
+        if (v.size() > kShown) s += ", ... (" + toString(v.size()) + " in all)";
+        return s + "}";
+    }
+};
+
 // A result that may be absent says which: "nullopt", or its value.
 template <typename T>
 struct StringMaker<std::optional<T>> {

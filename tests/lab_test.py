@@ -50,9 +50,9 @@ CONFIGURE = (["cmake", "--preset", "release", "-DCMAKE_CXX_FLAGS_RELEASE=-O1 -DN
                 if CCACHE else []))
 # What the users run, in order: (name, command, who, where). One line per command. who:
 # "both" at once, or the first or the second user alone; where: the clone, or the kit.
-# The grader's build and the kit's are a second build of the core each: the first user
-# grades while the second writes a starter kit and runs its check of one step, so the two
-# builds share the two cores.
+# The grader's build is a second build of the core (in its sandbox, without the cache): the
+# first user grades while the second writes a starter kit and runs its check of one step,
+# whose build takes the core and the tests from that user's cache.
 COMMANDS = [
     ("tour", ["./workbook", "tour", "--steps", STEP], "both", "clone"),
     ("test", ["./workbook", "test", "--steps", STEP], "both", "clone"),

@@ -608,7 +608,7 @@ TEST_SUITE("renderer") {
 }
 
 TEST_SUITE("program 01") {
-    const std::string program = BOXES_PROGRAM;
+    const std::string program = test::stepProgram();
 
     TEST_CASE("headless render writes a PNG of the requested size") {
         test::TempDir dir;

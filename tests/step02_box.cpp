@@ -434,7 +434,7 @@ TEST_SUITE("hard cases 02") {
 }
 
 TEST_SUITE("program 02") {
-    const std::string program = BOXES_PROGRAM;
+    const std::string program = test::stepProgram();
 
     TEST_CASE("the box scene renders the same image with both methods") {
         Scene a = makeBoxScene(4.0f / 3.0f), b = a;

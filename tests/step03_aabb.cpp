@@ -517,7 +517,7 @@ TEST_SUITE("why we care 03") {
 }
 
 TEST_SUITE("program 03") {
-    const std::string program = BOXES_PROGRAM;
+    const std::string program = test::stepProgram();
     const std::string small = " --spheres 200 --triangles 200";
 
     TEST_CASE("headless render writes a PNG of the requested size") {

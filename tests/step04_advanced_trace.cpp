@@ -174,7 +174,7 @@ size_t checkHitsFileAgainstBruteForce(const std::string& path, const Mesh& mesh,
 }  // namespace
 
 TEST_SUITE("program 04") {
-    const std::string program = BOXES_PROGRAM;
+    const std::string program = test::stepProgram();
 
     TEST_CASE("headless render writes a PNG of the requested size and the culling map") {
         test::TempDir dir;

@@ -1137,7 +1137,7 @@ TEST_SUITE("lab 05") {
 }
 
 TEST_SUITE("program 05") {
-    const std::string program = BOXES_PROGRAM;
+    const std::string program = test::stepProgram();
 
     TEST_CASE("headless render writes the image and every preview") {
         test::TempDir dir;

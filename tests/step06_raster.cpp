@@ -733,7 +733,7 @@ TEST_SUITE("frustum culling 06") {
 }
 
 TEST_SUITE("program 06") {
-    const std::string program = BOXES_PROGRAM;
+    const std::string program = test::stepProgram();
 
     TEST_CASE("headless render writes a PNG and the ids and depth buffers") {
         test::TempDir dir;

@@ -159,7 +159,7 @@ TEST_SUITE("textures 06") {
 
 TEST_SUITE("vertex work 06") {
     TEST_CASE("vertex work once per vertex per corner and per pixel: identical buffers") {
-        Scene scene = makeScene("bunny", {BOXES_TEST_DATA, 4.0f / 3.0f});
+        Scene scene = makeScene("bunny", {test::dataDir(), 4.0f / 3.0f});
         RasterScene raster = RasterScene::fromScene(scene);
         Camera close = scene.camera;
         close.eye = Vec3(-0.35f, 0.55f, 0.9f);

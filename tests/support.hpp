@@ -31,13 +31,88 @@ struct StringMaker<glm::vec<L, T, Q>> {
         return String(s.str().c_str());
     }
 };
+
+namespace detail {
+// The hits and intervals the steps return, known by their fields' names: this header
+// includes no step's header.
+template <typename T>
+concept StepResult = requires(const T& y) {
+    y.t, y.primitive, y.point;
+}
+|| requires(const T& y) {
+    y.t, y.triangle;
+}
+|| requires(const T& y) {
+    y.t, y.u, y.v;
+}
+|| requires(const T& y) {
+    y.t, y.normal, y.face, y.entering;
+}
+|| requires(const T& y) {
+    y.tnear, y.tfar;
+}
+|| requires(const T& y) {
+    y.normal, y.d;
+}
+|| requires(const T& y) {
+    y.min, y.max;
+};
+}  // namespace detail
+
+// A failing CHECK on a hit, an interval, a plane or a box prints its fields ("{t = 2, u = 0.2,
+// v = 0.3}") instead of {?}.
+template <detail::StepResult T>
+struct StringMaker<T> {
+    static String convert(const T& x) {
+        String fields;
+        if constexpr (requires { x.t, x.primitive, x.point; })
+            fields = "t = " + toString(x.t) + ", primitive " + toString(x.primitive) + " at " +
+                     toString(x.point) + ", u = " + toString(x.u) + ", v = " + toString(x.v);
+        else if constexpr (requires { x.t, x.triangle; })
+            fields = "t = " + toString(x.t) + ", triangle " + toString(x.triangle);
+        else if constexpr (requires { x.t, x.u, x.v; })
+            fields = "t = " + toString(x.t) + ", u = " + toString(x.u) + ", v = " + toString(x.v);
+        else if constexpr (requires { x.t, x.normal, x.face, x.entering; })
+            fields = "t = " + toString(x.t) + ", face " + toString(x.face) + ", normal " +
+                     toString(x.normal) + (x.entering ? ", entering" : ", leaving");
+        else if constexpr (requires { x.tnear, x.tfar; })
+            fields = "tnear = " + toString(x.tnear) + ", tfar = " + toString(x.tfar);
+        else if constexpr (requires { x.normal, x.d; })
+            fields = "normal " + toString(x.normal) + ", d = " + toString(x.d);
+        else
+            fields = "min " + toString(x.min) + ", max " + toString(x.max);
+        return "{" + fields + "}";
+    }
+};
+
+// A list (the triangles a traversal tested, say) prints its first elements: "{0, 1}".
+template <typename T, typename A>
+struct StringMaker<std::vector<T, A>> {
+    static String convert(const std::vector<T, A>& v) {
+        constexpr size_t kShown = 20;
+        String s = "{";
+        for (size_t i = 0; i < v.size() && i < kShown; ++i) s += (i ? ", " : "") + toString(v[i]);
+        if (v.size() > kShown) s += ", ... (" + toString(v.size()) + " in all)";
+        return s + "}";
+    }
+};
+
+// A result that may be absent says which: "nullopt", or its value.
+template <typename T>
+struct StringMaker<std::optional<T>> {
+    static String convert(const std::optional<T>& v) {
+        return v ? toString(*v) : String("nullopt");
+    }
+};
 }  // namespace doctest
 
 namespace boxes::test {
 
-inline std::string dataDir() {
-    return BOXES_TEST_DATA;
-}
+// The tree's data/ (test_main.cpp) and, in a step's test program, the step's program (a file
+// tests/CMakeLists.txt generates): paths outside the test files, which compile the same in
+// every tree.
+std::string dataDir();
+std::string stepProgram();
 
 // A fresh folder under the system's temporary directory, removed at scope exit.
 struct TempDir {

@@ -15,6 +15,13 @@
 #include <string>
 #include <thread>
 
+namespace boxes::test {
+// The tree's data/ (tests/support.hpp): only this file has its path compiled in.
+std::string dataDir() {
+    return BOXES_TEST_DATA;
+}
+}  // namespace boxes::test
+
 namespace {
 
 // CHECK catches what its expression throws, logs it and goes on: a stub called in a loop

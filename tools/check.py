@@ -105,15 +105,42 @@ def configure(root):
 
 
 def build_step(root, number, jobs=None):
-    """Builds the step's test program (and its program, for the pictures); None or the
-    first compile error."""
+    """Builds the step's test program (and its program, for the pictures), saying how far it
+    has got; None or the first compile error."""
     target = f"test_step{number:02d}"
     cmd = ["cmake", "--build", BUILD, "--target", target]
     if jobs:
         cmd += ["-j", str(jobs)]
-    r = subprocess.run(cmd, cwd=root, capture_output=True, text=True)
-    if r.returncode != 0:
-        return first_compile_error(r.stdout + r.stderr, root)
+    say(f"[check] building step {number:02d} ({target} and what it needs; a first build takes minutes)")
+    started = shown = time.monotonic()
+    tty = sys.stdout.isatty()
+    output, done, total = [], 0, 0
+    p = subprocess.Popen(cmd, cwd=root, stdout=subprocess.PIPE, stderr=subprocess.STDOUT, text=True,
+                         errors="replace")
+    try:
+        for line in p.stdout:
+            output.append(line)
+            m = re.match(r"\[(\d+)/(\d+)\] (?:Building|Linking)", line)
+            if not m:
+                continue
+            done, total = int(m.group(1)), int(m.group(2))
+            if tty:  # one line, rewritten
+                sys.stdout.write(f"\r\033[K[check]   {done}/{total} {line.split(' ', 1)[1].strip()[:60]}")
+                sys.stdout.flush()
+            elif time.monotonic() - shown >= 10:  # a log: a line every 10 s
+                shown = time.monotonic()
+                say(f"[check]   {done}/{total} built")
+        p.wait()
+    except BaseException:
+        p.kill()
+        p.wait()
+        raise
+    if tty and done:
+        sys.stdout.write("\r\033[K")
+    if p.returncode != 0:
+        return first_compile_error("".join(output), root)
+    if done:
+        say(f"[check]   {done} of {total} build steps done in {time.monotonic() - started:.0f} s")
     return None
 
 
@@ -141,6 +168,10 @@ def run_suite(binary, exercise_id, timeout):
             os.killpg(p.pid, signal.SIGKILL)
             p.communicate()
             kind, detail, err = "timed out", f"{timeout:g} s", b""
+        except BaseException:  # Ctrl-C or a signal: its own session does not get it
+            os.killpg(p.pid, signal.SIGKILL)
+            p.wait()
+            raise
         data = b""
         if os.path.exists(out):
             with open(out, "rb") as f:
@@ -268,7 +299,6 @@ def check_once(root, chosen, opts):
             row["status"], row["detail"] = "does not compile", problem
             continue
         if e.step not in built:
-            say(f"[check] building step {e.step:02d}")
             built[e.step] = build_step(root, e.step, opts.jobs)
         if built[e.step]:
             row["status"], row["detail"] = "does not compile", built[e.step]
@@ -496,14 +526,20 @@ def main(argv, root=ROOT):
         print(f"check: {exc}", file=sys.stderr)
         return 2
     everything = not opts.which
+
+    def stop(signum, _frame):  # as Ctrl-C: the temporary folders and the test program go
+        raise KeyboardInterrupt(signum)
+
+    for sig in (signal.SIGTERM, signal.SIGHUP):
+        signal.signal(sig, stop)
     try:
         if opts.watch:
             watch(root, chosen, opts, everything)
         rows = check_once(root, chosen, opts)
         return report(rows, root, opts, everything)
-    except KeyboardInterrupt:
+    except KeyboardInterrupt as stopped:
         say()
-        return 130
+        return 128 + (stopped.args[0] if stopped.args else signal.SIGINT)
 
 
 if __name__ == "__main__":

@@ -3,9 +3,14 @@ the PNG reader (tools/png.py): no build, no test program."""
 import json
 import os
 import re
+import stat
 import sys
 import tempfile
+import time
 import unittest
+from unittest import mock
+
+import scratch  # noqa: F401  (tempfile's folders go into one removed at exit)
 
 ROOT = os.path.dirname(os.path.dirname(os.path.dirname(os.path.abspath(__file__))))
 sys.path.insert(0, ROOT)
@@ -103,6 +108,57 @@ class Selection(unittest.TestCase):
         for bad in ("9.9", "1.44", "99", "x"):
             with self.assertRaises(ValueError):
                 check.select(self.all, [bad])
+
+
+# A stand-in for a step's test program: it writes doctest's XML for the suite asked, after
+# running BODY (shell) for exercise 1.1; every other exercise passes.
+FAKE = """#!/bin/sh
+for a; do case $a in --out=*) out=${a#--out=} ;; --test-suite=*) suite=${a#--test-suite=} ;; esac; done
+printf '<doctest><TestSuite name="%s"><TestCase name="its case" filename="t.cpp" line="1">' "$suite" >"$out"
+[ "$suite" = "exercise 1.1" ] && { BODY ; }
+printf '<OverallResultsAsserts successes="1" failures="0" test_case_success="true"/></TestCase></TestSuite></doctest>' >>"$out"
+"""
+
+
+class Limits(unittest.TestCase):
+    """An exercise whose tests crash or hang is reported as such, and check goes on."""
+
+    def tree(self, tmp, body):
+        tests = os.path.join(tmp, check.BUILD, "tests")
+        os.makedirs(tests)
+        path = os.path.join(tests, "test_step01")
+        with open(path, "w") as f:
+            f.write(FAKE.replace("BODY", body))
+        os.chmod(path, os.stat(path).st_mode | stat.S_IXUSR)
+        return path
+
+    def run_check(self, body, timeout=60.0):
+        chosen = [e for e in exercises(ROOT) if e.id in ("1.1", "1.2")]
+        opts = mock.Mock(timeout=timeout, jobs=None)
+        with tempfile.TemporaryDirectory() as tmp:
+            self.tree(tmp, body)
+            with mock.patch.object(check, "configure", return_value=None), \
+                 mock.patch.object(check, "build_step", return_value=None):
+                return {r["id"]: r for r in check.check_once(tmp, chosen, opts)}
+
+    def test_a_crash_names_its_signal_and_case_and_the_next_exercise_runs(self):
+        rows = self.run_check("kill -SEGV $$")
+        self.assertEqual(rows["1.1"]["status"], "crashed")
+        self.assertEqual(rows["1.1"]["detail"], 'SIGSEGV in test case "its case"')
+        self.assertEqual(rows["1.2"]["status"], "passed")
+
+    def test_a_hang_is_stopped_at_the_time_limit_and_the_next_exercise_runs(self):
+        started = time.monotonic()
+        rows = self.run_check("sleep 300", timeout=1.0)
+        self.assertLess(time.monotonic() - started, 100)  # stopped, not waited for
+        self.assertEqual(rows["1.1"]["status"], "timed out")
+        self.assertEqual(rows["1.1"]["detail"], '1 s in test case "its case"')
+        self.assertEqual(rows["1.2"]["status"], "passed")
+
+    def test_an_odd_exit_code_is_a_crash(self):
+        rows = self.run_check("exit 7")
+        self.assertEqual(rows["1.1"]["status"], "crashed")
+        self.assertTrue(rows["1.1"]["detail"].startswith("exit code 7"), rows["1.1"]["detail"])
 
 
 class Hints(unittest.TestCase):

@@ -1,11 +1,16 @@
 """Unit tests of tools/report.py: the Pareto front of error against time, and its plot."""
 import json
 import os
+import re
 import sys
 import tempfile
 import unittest
+from unittest import mock
+
+import scratch  # noqa: F401  (tempfile's folders go into one removed at exit)
 
 sys.path.insert(0, os.path.dirname(os.path.dirname(os.path.dirname(os.path.abspath(__file__)))))
+from tools import png, report  # noqa: E402
 from tools.report import pareto_front, plot, table_html  # noqa: E402
 
 
@@ -44,6 +49,48 @@ class Report(unittest.TestCase):
     def test_table_names_its_time_and_error(self):
         text = table_html(json.loads(json.dumps(self.TABLE)))
         self.assertIn("Time: <i>ms</i> (spread <i>lo</i> to <i>hi</i>); error: <i>err</i>", text)
+
+
+class ExerciseStatus(unittest.TestCase):
+    """The page's exercise table: the tour's test results, check's status where the tour ran
+    no test of the exercise, and a link to check's picture."""
+
+    def page(self, tour_cases, status):
+        with tempfile.TemporaryDirectory() as out:
+            os.makedirs(os.path.join(out, "check"))
+            if tour_cases is not None:
+                with open(os.path.join(out, "test_step01.xml"), "w") as f:
+                    f.write(f'<doctest><TestSuite name="exercise 1.4">{tour_cases}</TestSuite></doctest>')
+            with open(os.path.join(out, "check", "status.json"), "w") as f:
+                json.dump({"time": "12:00", "exercises": status}, f)
+            png.write(os.path.join(out, "check", "1.4.png"), 1, 1, [bytearray(3)])
+            with mock.patch("sys.argv", ["report", out]), mock.patch("sys.stderr"):
+                report.main()
+            with open(os.path.join(out, "index.html"), encoding="utf-8") as f:
+                text = f.read()
+        return {m[1]: m for m in re.findall(r"<tr class=(\w+)><td>([\d.]+)</td>(.*?)</tr>", text)}, text
+
+    CHECKED = [{"id": "1.4", "status": "failed", "picture": "out/check/1.4.png: 12 of 19200 pixels differ"},
+               {"id": "1.5", "status": "not started", "picture": "the bunny: once the exercise runs"}]
+
+    def test_the_tours_results_and_checks_picture(self):
+        passing = ('<TestCase name="c"><OverallResultsAsserts successes="1" failures="0" '
+                   'test_case_success="true"/></TestCase>')
+        rows, _ = self.page(passing, self.CHECKED)
+        css, _, cells = rows["1.4"]
+        self.assertEqual(css, "passed")
+        self.assertIn("<td>1/1</td><td>passed</td>", cells)
+        self.assertIn("<a href='check/1.4.png' title='out/check/1.4.png: 12 of 19200 pixels differ'>picture</a>",
+                      cells)
+        self.assertIn("(failed at 12:00)", cells)  # check's picture is of its own, older run
+
+    def test_checks_status_where_the_tour_ran_no_test(self):
+        rows, text = self.page(None, self.CHECKED)
+        self.assertEqual(rows["1.4"][0], "failed")
+        self.assertIn("<td>-</td><td>failed</td>", rows["1.4"][2])
+        self.assertEqual(rows["1.5"][0], "notstarted")
+        self.assertIn("once the exercise runs", rows["1.5"][2])
+        self.assertIn("<td>not run</td>", rows["1.6"][2])  # neither ran it
 
 
 if __name__ == "__main__":

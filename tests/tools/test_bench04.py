@@ -74,6 +74,24 @@ class Meshes(unittest.TestCase):
         self.assertTrue(os.path.exists(meshes.mesh_path("bunny", folder)))
 
 
+class Targets(unittest.TestCase):
+    def test_each_target_met_or_missed_by_its_worst_mesh(self):
+        rows = [{"builder": b, "mesh": m, "kind": k, "ratio": r} for b, m, k, r in [
+            ("sah 8-wide", "bunny", "primary", 1.2), ("sbvh 8-wide", "bunny", "primary", 1.4),
+            ("sah 8-wide", "thor", "primary", 1.35), ("sbvh 8-wide", "bunny", "diffuse", 0.8),
+            ("sah", "bunny", "primary", 0.75), ("sah", "thor", "primary", 0.6)]]
+        threads = [{"mesh": "bunny", "kind": "primary", "speedup": 1.95}]
+        lines = bench04.target_lines(rows, threads)
+        self.assertEqual(len(lines), 4)
+        # The best of the two 8-wide trees per mesh: 1.4 and 1.35, both >= 1.3.
+        self.assertIn("met (bunny 1.40x, thor 1.35x)", lines[0])
+        # Diffuse: 0.8 against 1.0 is 20% short.
+        self.assertIn("missed by 20% (bunny 0.80x)", lines[1])
+        # The binary tree: its worst mesh decides (0.6 against 0.75: 20% short).
+        self.assertIn("missed by 20% (bunny 0.75x, thor 0.60x)", lines[2])
+        self.assertIn(">= 1.90x: met (bunny primary 1.95x)", lines[3])
+
+
 class Ratios(unittest.TestCase):
     def test_per_round_ratios_sorted(self):
         ours = [{"s": 2.0}, {"s": 3.0}, {"s": 1.0}]

@@ -142,10 +142,11 @@ TEST_SUITE("hard cases reliability") {
         CHECK(refusal(tri + "vw 0 1 x\n") == "x.obj:5: vertex weight field 'x' is not a number");
         CHECK(parseObj(tri + "vw 0 1 0.5 2 -0.25\n").triangleCount() == 1);
     }
-    TEST_CASE("hard case: OBJ coordinates are read exactly, each rounded once to float") {
+    TEST_CASE("hard case: OBJ coordinates are read exactly and each rounded once to float") {
         // tinyobjloader computes mantissa * pow(10, exponent): 0e3800 came out NaN and the
         // file was refused as non-finite (found by the fuzz target's strict reader,
         // fuzz/corpus/obj/crash-b1ecff...). The reader keeps its own std::from_chars values.
+        test::FpTrapsOff nanOnPurpose;  // tinyobjloader's 0 * inf, whose result is discarded
         Mesh m = parseObj("v 0e3800 0.1 16777217\nv 1 0 1e-45\nv 0 1 -0e-999\nf 1 2 3\n");
         REQUIRE(m.positions.size() == 3);
         CHECK(m.positions[0].x == 0.0f);

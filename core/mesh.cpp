@@ -237,7 +237,8 @@ std::vector<Vec3> checkLines(std::string_view text, const std::string& name,
             // file, with none at all it keeps an empty one (found by the fuzz target's strict
             // reader). An element that names no vertex is refused either way.
             else if (fields.empty())
-                throw InputError(where() + "a '" + std::string(1, line[0]) + "' line names no vertex");
+                throw InputError(where() + "a '" + std::string(1, line[0]) +
+                                 "' line names no vertex");
             for (std::string_view field : fields) checkIndexToken(field, counts, where());
         } else if (keyword("s")) {
             auto fields = splitFields(line.substr(2), 2);

@@ -150,12 +150,12 @@ TEST_SUITE("hard cases reliability") {
         Mesh m = parseObj("v 0e3800 0.1 16777217\nv 1 0 1e-45\nv 0 1 -0e-999\nf 1 2 3\n");
         REQUIRE(m.positions.size() == 3);
         CHECK(m.positions[0].x == 0.0f);
-        CHECK(m.positions[0].y == 0.1f);            // the float nearest 0.1
-        CHECK(m.positions[0].z == 16777216.0f);     // 2^24 + 1 is a tie: rounds to even
-        CHECK(m.positions[1].z == 0x1p-149f);       // the smallest subnormal float
-        CHECK(std::signbit(m.positions[2].z));      // -0 stays -0
+        CHECK(m.positions[0].y == 0.1f);         // the float nearest 0.1
+        CHECK(m.positions[0].z == 16777216.0f);  // 2^24 + 1 is a tie: rounds to even
+        CHECK(m.positions[1].z == 0x1p-149f);    // the smallest subnormal float
+        CHECK(std::signbit(m.positions[2].z));   // -0 stays -0
     }
-    TEST_CASE("hard case: an OBJ line or point element that names no vertex is refused with its line") {
+    TEST_CASE("hard case: an OBJ l or p line that names no vertex is refused with its line") {
         // tinyobjloader refused 'l' followed by blanks only as "zero value for vertex index"
         // and kept 'l' alone as an empty element (found by the fuzz target's strict reader,
         // fuzz/corpus/obj/crash-690497...).

@@ -90,9 +90,9 @@ def verdict(row, pixels):
         culling = ("; the frustum culling costs more than it saves here (without it, "
                    "visibility at x%.2f)" % row["no_culling_ratio"])
     return ("%s: target missed: step 06 %s. In the way: the work per pixel centre covered "
-            "(%d of them, %.1f per pixel; %.0f ns each in the unculled frame: three edge "
-            "functions per pixel of each triangle's bounding box, then 1/w and the "
-            "perspective-correct weights in double precision, one pixel at a time), where "
+            "(%d of them, %.1f per pixel; %.0f ns each in the unculled frame: every pixel of "
+            "each triangle's bounding box visited, then 1/w and the perspective-correct "
+            "weights in double precision, one pixel at a time), where "
             "llvmpipe rejects and accepts whole blocks of pixels and shades 4x4 blocks with "
             "SIMD in JIT-compiled code; culling kept %d of %d triangles%s"
             % (row["mesh"], " and ".join(parts), row["fragments"], row["fragments"] / pixels,

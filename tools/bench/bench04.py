@@ -43,9 +43,10 @@ import tempfile
 import time
 
 try:
-    from tools.bench import meshes  # imported as tools.bench.bench04 (the tests)
+    from tools.bench import machine, meshes  # imported as tools.bench.bench04 (the tests)
 except ImportError:
-    import meshes  # run as a script: its folder is on the path
+    import machine  # run as a script: its folder is on the path
+    import meshes
 
 ROOT = os.path.dirname(os.path.dirname(os.path.dirname(os.path.abspath(__file__))))
 INSIDE = ["--eye", "960,-384,2", "--look", "960,600,2", "--up", "0,0,1", "--fov", "90"]
@@ -431,14 +432,10 @@ def bench(a, work):
                 "bench04_embree). The targets: the best 8-wide tree at least 1.3 on primary "
                 "and 1.0 on diffuse rays, the binary SAH tree ('sah') 0.75 on primary rays"
                 % a.rounds}
-    cpu = "unknown CPU"
-    try:
-        cpu = [l.split(":", 1)[1].strip() for l in open("/proc/cpuinfo")
-               if l.startswith("model name")][0]
-    except (OSError, IndexError):
-        pass
     report = {"program": "04_bvh_bench", "images": [],
-              "machine": "%s, %d cores, load average %.1f" % (cpu, os.cpu_count(), load), "facts": {"load_average": os.getloadavg()[0]}, "rays": a.rays, "repeat": a.repeat, "load_average": load, "quiet_wait_s": gate.waited, "unavailable": unavailable,
+              "machine": machine.describe(load), "facts": {"load_average": os.getloadavg()[0]},
+              "rays": a.rays, "repeat": a.repeat, "load_average": load,
+              "quiet_wait_s": gate.waited, "unavailable": unavailable,
               "tables": [
                   ratios_table,
                   {"id": "bench04_embree", "title": "Step 04 beside Embree 3: one thread each",

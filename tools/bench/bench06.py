@@ -26,9 +26,10 @@ import subprocess
 import sys
 
 try:
-    from tools.bench import meshes  # imported as tools.bench.bench06 (the tests)
+    from tools.bench import machine, meshes  # imported as tools.bench.bench06 (the tests)
 except ImportError:
-    import meshes  # run as a script: its folder is on the path
+    import machine  # run as a script: its folder is on the path
+    import meshes
 
 ROOT = os.path.dirname(os.path.dirname(os.path.dirname(os.path.abspath(__file__))))
 TARGET = 1.0  # step 06 at least as fast as llvmpipe
@@ -163,14 +164,8 @@ def main(argv=None):
         print("Left out: %s" % line)
     load = os.getloadavg()[0]
     print("(load average during the run: %.1f on %d cores)" % (load, os.cpu_count()))
-    cpu = "unknown CPU"
-    try:
-        cpu = [l.split(":", 1)[1].strip() for l in open("/proc/cpuinfo")
-               if l.startswith("model name")][0]
-    except (OSError, IndexError):
-        pass
     report = {"program": "06_raster_bench", "images": [], "facts": {"load_average": load},
-              "machine": "%s, %d cores, load average %.1f" % (cpu, os.cpu_count(), load),
+              "machine": machine.describe(load),
               "width": a.width, "height": a.height, "rounds": a.rounds, "repeat": a.repeat,
               "unavailable": unavailable, "rows": rows,
               "tables": [{

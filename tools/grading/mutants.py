@@ -283,6 +283,34 @@ def table(rows):
     return "\n".join(f"{r[0]:<{w[0]}}  {r[1]:<{w[1]}}  {r[2]:<{w[2]}}  {r[3]}" for r in lines)
 
 
+def list_or_check(tool, noun, selected, total, describe, check, flags, stop_on_problems):
+    """What --list, --check and a broken catalogue make of a run (shared with safeguards.py):
+    (an exit status or None when the run goes on, the catalogue's problems). describe(item)
+    is its --list line, check() finds the problems (printed; with stop_on_problems they end
+    the run)."""
+    if "--list" in flags:
+        for item in selected:
+            print(describe(item))
+        return 0, []
+    problems = check()
+    for p in problems:
+        print(f"{tool}: {p}", file=sys.stderr)
+    if "--check" in flags:
+        print(f"{tool}: {total} {noun}, {'sound' if not problems else f'{len(problems)} problems'}")
+        return (1 if problems else 0), problems
+    return (1 if problems and stop_on_problems else None), problems
+
+
+def private_tree():
+    """The reference tree's private copy under build/mutants/, synced, a patch left applied
+    by an interrupted run taken back."""
+    tree = os.path.join(ROOT, "build", "mutants", "tree")
+    os.makedirs(tree, exist_ok=True)
+    sync_tree(ROOT, tree)
+    recover(tree)
+    return tree
+
+
 def main(argv):
     if "--safeguards" in argv:
         from . import safeguards
@@ -302,21 +330,12 @@ def main(argv):
               "starter kit", file=sys.stderr)
         return 2
     mutants = select(catalogue(), args)
-    if "--list" in flags:
-        for m in mutants:
-            print(f"{m.id:<40} {m.mistake}")
-        return 0
-    problems = check_catalogue()
-    for p in problems:
-        print(f"mutants: {p}", file=sys.stderr)
-    if "--check" in flags:
-        print(f"mutants: {len(catalogue())} mutants, "
-              f"{'sound' if not problems else f'{len(problems)} problems'}")
-        return 1 if problems else 0
-    tree = os.path.join(ROOT, "build", "mutants", "tree")
-    os.makedirs(tree, exist_ok=True)
-    sync_tree(ROOT, tree)
-    recover(tree)
+    status, problems = list_or_check("mutants", "mutants", mutants, len(catalogue()),
+                                     lambda m: f"{m.id:<40} {m.mistake}", check_catalogue,
+                                     flags, stop_on_problems=False)
+    if status is not None:
+        return status
+    tree = private_tree()
     log_path = os.path.join(ROOT, "build", "mutants", "log.txt")
     rows, started = [], time.monotonic()
     with open(log_path, "w", encoding="utf-8") as log:

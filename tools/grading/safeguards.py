@@ -32,8 +32,8 @@ import time
 from dataclasses import dataclass, field
 
 from . import ROOT
-from .mutants import TEST_TIMEOUT, build_dir, configure, git_apply, recover, sync_tree
-from .mutants import applied_marker
+from .mutants import TEST_TIMEOUT, applied_marker, build_dir, configure, git_apply
+from .mutants import list_or_check, private_tree
 
 SAFEGUARDS_DIR = "tests/safeguards"
 NAME = re.compile(r"^[a-z0-9][a-z0-9-]*\.patch$")
@@ -255,24 +255,13 @@ def main(argv):
             print(f"safeguards: no safeguard '{unknown[0]}' (--safeguards --list)", file=sys.stderr)
             return 2
         safeguards = [by_id[a] for a in args]
-    if "--list" in flags:
-        for s in safeguards:
-            print(f"{s.id:<32} {s.safeguard}")
-        return 0
-    problems = check_catalogue()
-    for p in problems:
-        print(f"safeguards: {p}", file=sys.stderr)
-    if "--check" in flags:
-        print(f"safeguards: {len(catalogue())} safeguards, "
-              f"{'sound' if not problems else f'{len(problems)} problems'}")
-        return 1 if problems else 0
-    if problems:
-        return 1
+    status, _ = list_or_check("safeguards", "safeguards", safeguards, len(catalogue()),
+                              lambda s: f"{s.id:<32} {s.safeguard}", check_catalogue, flags,
+                              stop_on_problems=True)
+    if status is not None:
+        return status
     where = case_programs()
-    tree = os.path.join(ROOT, "build", "mutants", "tree")
-    os.makedirs(tree, exist_ok=True)
-    sync_tree(ROOT, tree)
-    recover(tree)
+    tree = private_tree()
     log_path = os.path.join(ROOT, "build", "mutants", "safeguards-log.txt")
     rows, started, checked = [], time.monotonic(), {}
     with open(log_path, "w", encoding="utf-8") as log:

@@ -31,6 +31,14 @@ SOURCE = "float sum(float a, float b) {\n    return a + b;\n}\n"
 TESTS = 'TEST_SUITE("exercise 1.1") {\n    TEST_CASE("sum: worked values") {}\n}\n'
 
 
+def write_files(root, files):
+    """{path relative to root: text} written, folders made."""
+    for rel, text in files.items():
+        os.makedirs(os.path.dirname(os.path.join(root, rel)), exist_ok=True)
+        with open(os.path.join(root, rel), "w") as f:
+            f.write(text)
+
+
 def small_tree(patch=PATCH, hints=None):
     root = tempfile.mkdtemp()
     files = {"steps/01_x/x.cpp": SOURCE, "tests/step01_x.cpp": TESTS,
@@ -38,10 +46,7 @@ def small_tree(patch=PATCH, hints=None):
              "tests/hints/mistakes.json": json.dumps(
                  hints if hints is not None else
                  {"sum: worked values": {"exercise": "1.1", "hint": "a sum adds"}})}
-    for rel, text in files.items():
-        os.makedirs(os.path.dirname(os.path.join(root, rel)), exist_ok=True)
-        with open(os.path.join(root, rel), "w") as f:
-            f.write(text)
+    write_files(root, files)
     return root
 
 
@@ -137,10 +142,7 @@ def safeguard_tree(patch=SAFEGUARD, tests=None):
     files = {"tests/safeguards/sum-adds.patch": patch,
              "tests/step01_x.cpp": tests or 'TEST_CASE("hard case: sums") {}\n',
              "tests/hard_cases.cpp": 'TEST_CASE("hard case: far") {}\n'}
-    for rel, text in files.items():
-        os.makedirs(os.path.dirname(os.path.join(root, rel)), exist_ok=True)
-        with open(os.path.join(root, rel), "w") as f:
-            f.write(text)
+    write_files(root, files)
     return root
 
 

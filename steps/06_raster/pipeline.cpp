@@ -1,5 +1,6 @@
 #include "06_raster/pipeline.hpp"
 
+#include <memory>
 #include <string>
 
 #include "core/bounds.hpp"
@@ -168,7 +169,6 @@ FrameStats rasterizeFrame(const RasterScene& scene, const Camera& camera,
         glm::dvec2 exact[3];
         glm::dvec3 w, inverseW;
         double area = 0.0;
-        bool useExact = false;
     };
     auto cross = [](glm::dvec2 a, glm::dvec2 b) { return a.x * b.y - a.y * b.x; };
     auto setUp = [&](const Vec4d* clip[3], Corners& c) {
@@ -178,8 +178,65 @@ FrameStats rasterizeFrame(const RasterScene& scene, const Camera& camera,
         }
         c.inverseW = 1.0 / c.w;
         c.area = cross(c.exact[1] - c.exact[0], c.exact[2] - c.exact[0]);
-        c.useExact = std::abs(c.area) > 1e-9;
+        // Too thin unsnapped: the snapped corners (exact in double) give the weights.
+        if (!(std::abs(c.area) > 1e-9)) {
+            for (int i = 0; i < 3; ++i) {
+                FixedPoint2 f = snapToSubpixel(c.exact[i].x, c.exact[i].y);
+                c.exact[i] = glm::dvec2(double(f.x), double(f.y)) / double(kSubpixelOne);
+            }
+            c.area = cross(c.exact[1] - c.exact[0], c.exact[2] - c.exact[0]);
+        }
     };
+    // The screen weights of a pixel centre: affine in screen space, from the unsnapped
+    // corners, so snapping moves edges by at most 1/512 pixel but never tilts the plane.
+    auto screenWeights = [&](const Corners& c, int x, int y) {
+        glm::dvec2 p(double(x) + 0.5, double(y) + 0.5);
+        const glm::dvec2* e = c.exact;
+        return glm::dvec3(cross(e[2] - e[1], p - e[1]), cross(e[0] - e[2], p - e[2]),
+                          cross(e[1] - e[0], p - e[0])) /
+               c.area;
+    };
+    // 1/w is affine in screen space too (it is dot(screen weights, 1/w_i)): its value at the
+    // centre of the pixel holding corner 0 and its steps per pixel, so a fragment's depth
+    // costs two multiplications and one division.
+    struct InversePlane {
+        int x = 0, y = 0;
+        double at = 0.0, dx = 0.0, dy = 0.0;
+        double operator()(int px, int py) const {
+            return at + double(px - x) * dx + double(py - y) * dy;
+        }
+    };
+    auto inversePlane = [&](const Corners& c) {
+        InversePlane p;
+        const glm::dvec2* e = c.exact;
+        p.x = int(std::floor(e[0].x));
+        p.y = int(std::floor(e[0].y));
+        p.at = glm::dot(screenWeights(c, p.x, p.y), c.inverseW);
+        for (int i = 0; i < 3; ++i) {
+            glm::dvec2 edge = e[(i + 2) % 3] - e[(i + 1) % 3];
+            p.dx -= edge.y * c.inverseW[i] / c.area;
+            p.dy += edge.x * c.inverseW[i] / c.area;
+        }
+        return p;
+    };
+
+    // Deferred attributes (a visibility buffer, Burns, Hunt 2013): a fragment that passes
+    // the depth test stores its triangle and which fan piece drew it; the weights are
+    // computed once per visible pixel after the last triangle, not for every fragment that
+    // is later overdrawn. A piece is kept for clipped triangles (and, when the vertex work
+    // is not done once per vertex, for all of them); the others are read back from the
+    // triangle's clip positions.
+    struct Piece {
+        Corners corners;
+        glm::dvec3 weights[3];  // of the original triangle's vertices, at the piece's corners
+    };
+    std::vector<Piece> pieces;
+    constexpr uint32_t kWholeTriangle = ~uint32_t(0);
+    const size_t pixels = size_t(width) * size_t(height);
+    std::unique_ptr<uint32_t[]> pieceOf(settings.depthOnly ? nullptr : new uint32_t[pixels]);
+    float* const depthBuffer = buffers.depth.data();
+    uint32_t* const triangleBuffer = buffers.triangle.data();
+    size_t fragments = 0;
 
     auto draw = [&](size_t t) {
         ++stats.trianglesIn;
@@ -230,40 +287,29 @@ FrameStats rasterizeFrame(const RasterScene& scene, const Camera& camera,
             FixedPoint2 s[3];
             for (int i = 0; i < 3; ++i)
                 s[i] = snapToSubpixel(corners.exact[i].x, corners.exact[i].y);
-            // Coverage comes from the snapped (exact integer) edge functions; the weights
-            // for depth and attributes from the unsnapped positions, so snapping moves
-            // edges by at most 1/512 pixel but never tilts the interpolated plane.
-            int64_t area = rasterizeTriangle(
-                s[0], s[1], s[2], width, height, settings.backfaceCulling,
-                [&](int x, int y, glm::dvec3 screen) {
-                    ++stats.fragments;
-                    Corners again;
-                    const Corners* c = &corners;
+            const InversePlane plane = inversePlane(corners);
+            uint32_t piece = kWholeTriangle;
+            if (!inside || work != VertexWork::OncePerVertex) {
+                piece = uint32_t(pieces.size());
+                pieces.push_back({corners, {v[0]->weights, v[1]->weights, v[2]->weights}});
+            }
+            // Coverage from the snapped (exact integer) edge functions, depth from the
+            // unsnapped corners.
+            int64_t area = rasterizeTriangleBlocks(
+                s[0], s[1], s[2], width, height, settings.backfaceCulling, [&](int x, int y) {
+                    ++fragments;
+                    double inverseW = plane(x, y);
                     if (perPixel) {
                         Vec4d p[3] = {transform(tri[0]), transform(tri[1]), transform(tri[2])};
                         const Vec4d* q[3] = {&p[0], &p[1], &p[2]};
+                        Corners again;
                         setUp(q, again);
-                        c = &again;
+                        inverseW = inversePlane(again)(x, y);
                     }
-                    if (c->useExact) {
-                        glm::dvec2 p(double(x) + 0.5, double(y) + 0.5);
-                        const glm::dvec2* e = c->exact;
-                        screen =
-                            glm::dvec3(cross(e[2] - e[1], p - e[1]), cross(e[0] - e[2], p - e[2]),
-                                       cross(e[1] - e[0], p - e[0])) /
-                            c->area;
-                    }
-                    double depth = 1.0 / glm::dot(screen, c->inverseW);
-                    size_t i = buffers.index(x, y);
-                    if (!depthTest(buffers.depth[i], float(depth)) || settings.depthOnly) return;
-                    glm::dvec3 l = settings.perspectiveCorrect
-                                       ? perspectiveCorrectWeights(screen, c->w)
-                                       : screen;
-                    glm::dvec3 original =
-                        l.x * v[0]->weights + l.y * v[1]->weights + l.z * v[2]->weights;
-                    buffers.triangle[i] = uint32_t(t);
-                    buffers.weight1[i] = float(original.y);
-                    buffers.weight2[i] = float(original.z);
+                    const size_t i = size_t(y) * size_t(width) + size_t(x);
+                    if (!depthTest(depthBuffer[i], float(1.0 / inverseW)) || !pieceOf) return;
+                    triangleBuffer[i] = uint32_t(t);
+                    pieceOf[i] = piece;
                 });
             drawn = drawn || area < 0 || (area > 0 && !settings.backfaceCulling);
         }
@@ -279,6 +325,38 @@ FrameStats rasterizeFrame(const RasterScene& scene, const Camera& camera,
         for (size_t t = scene.meshTriangles; t < scene.triangles.size(); ++t) draw(t);
     } else {
         for (size_t t = 0; t < scene.triangles.size(); ++t) draw(t);
+    }
+    stats.fragments = fragments;
+
+    // The resolve: per visible pixel its perspective-correct weights (Heckbert, Moreton
+    // 1991), blended from the piece's corners to the original triangle's vertices.
+    // Neighbouring pixels mostly show the same piece, so its corners are set up once per run.
+    if (pieceOf) {
+        Corners whole;
+        uint32_t wholeOf = kNoPrimitive;
+        for (int y = 0; y < height; ++y)
+            for (int x = 0; x < width; ++x) {
+                const size_t i = buffers.index(x, y);
+                const uint32_t t = triangleBuffer[i];
+                if (t == kNoPrimitive) continue;
+                const Piece* piece = pieceOf[i] == kWholeTriangle ? nullptr : &pieces[pieceOf[i]];
+                if (!piece && t != wholeOf) {
+                    const auto& tri = scene.triangles[t];
+                    const Vec4d* clip[3] = {&buffers.clipPositions[tri[0]],
+                                            &buffers.clipPositions[tri[1]],
+                                            &buffers.clipPositions[tri[2]]};
+                    setUp(clip, whole);
+                    wholeOf = t;
+                }
+                const Corners& c = piece ? piece->corners : whole;
+                const glm::dvec3 screen = screenWeights(c, x, y);
+                glm::dvec3 l =
+                    settings.perspectiveCorrect ? perspectiveCorrectWeights(screen, c.w) : screen;
+                if (piece)
+                    l = l.x * piece->weights[0] + l.y * piece->weights[1] + l.z * piece->weights[2];
+                buffers.weight1[i] = float(l.y);
+                buffers.weight2[i] = float(l.z);
+            }
     }
     for (float d : buffers.depth) stats.pixelsCovered += d != kInfinity<float>;
     stats.milliseconds = watch.milliseconds();

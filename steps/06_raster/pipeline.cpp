@@ -1,6 +1,5 @@
 #include "06_raster/pipeline.hpp"
 
-#include <memory>
 #include <string>
 
 #include "core/bounds.hpp"
@@ -137,6 +136,7 @@ void FrameBuffers::reset(int w, int h, bool depthOnly) {
     triangle.assign(depthOnly ? 0 : n, kNoPrimitive);
     weight1.assign(depthOnly ? 0 : n, 0.0f);
     weight2.assign(depthOnly ? 0 : n, 0.0f);
+    piece.resize(depthOnly ? 0 : n);  // written wherever a triangle is
 }
 
 FrameStats rasterizeFrame(const RasterScene& scene, const Camera& camera,
@@ -168,7 +168,7 @@ FrameStats rasterizeFrame(const RasterScene& scene, const Camera& camera,
     struct Corners {
         glm::dvec2 exact[3];
         glm::dvec3 w, inverseW;
-        double area = 0.0;
+        double area = 0.0, inverseArea = 0.0;
     };
     auto cross = [](glm::dvec2 a, glm::dvec2 b) { return a.x * b.y - a.y * b.x; };
     auto setUp = [&](const Vec4d* clip[3], Corners& c) {
@@ -186,6 +186,7 @@ FrameStats rasterizeFrame(const RasterScene& scene, const Camera& camera,
             }
             c.area = cross(c.exact[1] - c.exact[0], c.exact[2] - c.exact[0]);
         }
+        c.inverseArea = 1.0 / c.area;  // a multiplication per pixel instead of a division
     };
     // The screen weights of a pixel centre: affine in screen space, from the unsnapped
     // corners, so snapping moves edges by at most 1/512 pixel but never tilts the plane.
@@ -193,8 +194,8 @@ FrameStats rasterizeFrame(const RasterScene& scene, const Camera& camera,
         glm::dvec2 p(double(x) + 0.5, double(y) + 0.5);
         const glm::dvec2* e = c.exact;
         return glm::dvec3(cross(e[2] - e[1], p - e[1]), cross(e[0] - e[2], p - e[2]),
-                          cross(e[1] - e[0], p - e[0])) /
-               c.area;
+                          cross(e[1] - e[0], p - e[0])) *
+               c.inverseArea;
     };
     // 1/w is affine in screen space too (it is dot(screen weights, 1/w_i)): its value at the
     // centre of the pixel holding corner 0 and its steps per pixel, so a fragment's depth
@@ -203,7 +204,7 @@ FrameStats rasterizeFrame(const RasterScene& scene, const Camera& camera,
         int x = 0, y = 0;
         double at = 0.0, dx = 0.0, dy = 0.0;
         double operator()(int px, int py) const {
-            return at + double(px - x) * dx + double(py - y) * dy;
+            return at + double(py - y) * dy + double(px - x) * dx;  // a row's part first
         }
     };
     auto inversePlane = [&](const Corners& c) {
@@ -232,11 +233,14 @@ FrameStats rasterizeFrame(const RasterScene& scene, const Camera& camera,
     };
     std::vector<Piece> pieces;
     constexpr uint32_t kWholeTriangle = ~uint32_t(0);
-    const size_t pixels = size_t(width) * size_t(height);
-    std::unique_ptr<uint32_t[]> pieceOf(settings.depthOnly ? nullptr : new uint32_t[pixels]);
     float* const depthBuffer = buffers.depth.data();
     uint32_t* const triangleBuffer = buffers.triangle.data();
     size_t fragments = 0;
+    // A fragment certainly behind a stored depth (1/w smaller than 1/stored by far more than
+    // rounding) fails the depth test: no need to divide for its depth and test it.
+    auto behind = [](double inverseW, float stored) {
+        return inverseW > 0.0 && inverseW * double(stored) < 1.0 - 1e-9;
+    };
 
     auto draw = [&](size_t t) {
         ++stats.trianglesIn;
@@ -293,24 +297,34 @@ FrameStats rasterizeFrame(const RasterScene& scene, const Camera& camera,
                 piece = uint32_t(pieces.size());
                 pieces.push_back({corners, {v[0]->weights, v[1]->weights, v[2]->weights}});
             }
+            // A fragment's work: the depth test, then for the resolve the triangle and the
+            // piece. What it reads is copied in, so that the compiler keeps it in registers.
+            const size_t stride = size_t(width);
+            const uint32_t id = uint32_t(t);
+            uint32_t* const pieceBuffer = buffers.piece.data();
+            auto fragment = [=](int x, int y, double inverseW) {
+                const size_t i = size_t(y) * stride + size_t(x);
+                if (behind(inverseW, depthBuffer[i])) return;  // the division saved
+                if (!depthTest(depthBuffer[i], float(1.0 / inverseW)) || !pieceBuffer) return;
+                triangleBuffer[i] = id;
+                pieceBuffer[i] = piece;
+            };
+            // Per pixel, the corners again (the vertex work's lesson), else the plane.
+            auto again = [&](int x, int y) {
+                Vec4d p[3] = {transform(tri[0]), transform(tri[1]), transform(tri[2])};
+                const Vec4d* q[3] = {&p[0], &p[1], &p[2]};
+                Corners c;
+                setUp(q, c);
+                fragment(x, y, inversePlane(c)(x, y));
+            };
             // Coverage from the snapped (exact integer) edge functions, depth from the
             // unsnapped corners.
-            int64_t area = rasterizeTriangleBlocks(
-                s[0], s[1], s[2], width, height, settings.backfaceCulling, [&](int x, int y) {
-                    ++fragments;
-                    double inverseW = plane(x, y);
-                    if (perPixel) {
-                        Vec4d p[3] = {transform(tri[0]), transform(tri[1]), transform(tri[2])};
-                        const Vec4d* q[3] = {&p[0], &p[1], &p[2]};
-                        Corners again;
-                        setUp(q, again);
-                        inverseW = inversePlane(again)(x, y);
-                    }
-                    const size_t i = size_t(y) * size_t(width) + size_t(x);
-                    if (!depthTest(depthBuffer[i], float(1.0 / inverseW)) || !pieceOf) return;
-                    triangleBuffer[i] = uint32_t(t);
-                    pieceOf[i] = piece;
-                });
+            const int64_t area =
+                perPixel ? rasterizeTriangleBlocks(s[0], s[1], s[2], width, height,
+                                                   settings.backfaceCulling, fragments, again)
+                         : rasterizeTriangleBlocks(
+                               s[0], s[1], s[2], width, height, settings.backfaceCulling, fragments,
+                               [=](int x, int y) { fragment(x, y, plane(x, y)); });
             drawn = drawn || area < 0 || (area > 0 && !settings.backfaceCulling);
         }
         if (drawn)
@@ -331,7 +345,7 @@ FrameStats rasterizeFrame(const RasterScene& scene, const Camera& camera,
     // The resolve: per visible pixel its perspective-correct weights (Heckbert, Moreton
     // 1991), blended from the piece's corners to the original triangle's vertices.
     // Neighbouring pixels mostly show the same piece, so its corners are set up once per run.
-    if (pieceOf) {
+    if (!settings.depthOnly) {
         Corners whole;
         uint32_t wholeOf = kNoPrimitive;
         for (int y = 0; y < height; ++y)
@@ -339,7 +353,8 @@ FrameStats rasterizeFrame(const RasterScene& scene, const Camera& camera,
                 const size_t i = buffers.index(x, y);
                 const uint32_t t = triangleBuffer[i];
                 if (t == kNoPrimitive) continue;
-                const Piece* piece = pieceOf[i] == kWholeTriangle ? nullptr : &pieces[pieceOf[i]];
+                const uint32_t k = buffers.piece[i];
+                const Piece* piece = k == kWholeTriangle ? nullptr : &pieces[k];
                 if (!piece && t != wholeOf) {
                     const auto& tri = scene.triangles[t];
                     const Vec4d* clip[3] = {&buffers.clipPositions[tri[0]],

@@ -66,6 +66,7 @@ struct FrameBuffers {
     std::vector<float> depth;        // +infinity where nothing is drawn
     std::vector<float> weight1, weight2;
     std::vector<Vec4d> clipPositions;  // per vertex, when the vertex work is done once
+    std::vector<uint32_t> piece;  // per pixel, for rasterizeFrame's resolve: the fan piece seen
     void reset(int w, int h, bool depthOnly = false);
     size_t index(int x, int y) const { return size_t(y) * size_t(width) + size_t(x); }
 };

@@ -4,7 +4,9 @@
 // rule, hidden surfaces removed by a z-buffer, and attributes interpolated with 1/w.
 #pragma once
 
+#include <algorithm>
 #include <array>
+#include <cmath>
 #include <cstdint>
 #include <glm/mat4x4.hpp>
 
@@ -168,16 +170,19 @@ int64_t rasterizeTriangle(FixedPoint2 v0, FixedPoint2 v1, FixedPoint2 v2, int wi
 }
 
 // The pixels rasterizeTriangle covers (the same edge functions, bias and bounding box, so
-// the same bits), found in blocks of 8x8 pixels as hardware and llvmpipe do: an edge
-// function is affine, so over a block it is smallest and largest at the block's corners.
-// A block with all four corners outside one edge is skipped; one with all corners inside
-// every edge is covered without a test per pixel (trivial reject and accept: McCool, Wales,
-// Moule 2001; Abrash 2009). Exact in integers. Calls covered(x, y) for every covered pixel
-// centre, block by block (the order does not matter: each pixel is visited once); the
-// caller computes what it needs there. Returns the signed area as rasterizeTriangle does.
+// the same bits), found block by block on the screen's grid of kRasterBlock x kRasterBlock
+// pixels, as hardware and llvmpipe do. An edge function is affine, so over a block it is
+// smallest and largest at the block's corners: a block with all corners outside one edge is
+// skipped, one with all corners inside every edge is covered without a test per pixel
+// (trivial reject and accept: McCool, Wales, Moule 2001; Abrash 2009), exact in integers.
+// Calls covered(x, y) for every covered pixel centre, block by block (each pixel once; the
+// order does not matter); `fragments` grows by their number. Returns the signed area as
+// rasterizeTriangle does.
+constexpr int kRasterBlock = 8;
 template <typename Covered>
 int64_t rasterizeTriangleBlocks(FixedPoint2 v0, FixedPoint2 v1, FixedPoint2 v2, int width,
-                                int height, bool cullBackFaces, Covered&& covered) {
+                                int height, bool cullBackFaces, size_t& fragments,
+                                Covered&& covered) {
     const int64_t area = edgeFunction(v0, v1, v2);
     if (area == 0 || (cullBackFaces && area > 0)) return area;
     if (area < 0) std::swap(v1, v2);
@@ -204,16 +209,17 @@ int64_t rasterizeTriangleBlocks(FixedPoint2 v0, FixedPoint2 v1, FixedPoint2 v2, 
         dy[k] = edgeFunction(a[k], b[k], {start.x, start.y + kSubpixelOne}) -
                 edgeFunction(a[k], b[k], start);
     }
-    constexpr int64_t kBlock = 8;
-    for (int64_t by = y0; by <= y1; by += kBlock) {
-        const int64_t ny = std::min(kBlock, y1 - by + 1);
-        for (int64_t bx = x0; bx <= x1; bx += kBlock) {
-            const int64_t nx = std::min(kBlock, x1 - bx + 1);
+    constexpr int64_t kBlock = kRasterBlock;
+    size_t count = 0;
+    for (int64_t by = y0 - y0 % kBlock; by <= y1; by += kBlock) {
+        const int64_t py0 = std::max(by, y0), py1 = std::min(by + kBlock - 1, y1);
+        for (int64_t bx = x0 - x0 % kBlock; bx <= x1; bx += kBlock) {
+            const int64_t px0 = std::max(bx, x0), px1 = std::min(bx + kBlock - 1, x1);
             int64_t e[3];
             bool outside = false, inside = true;
             for (int k = 0; k < 3; ++k) {
-                e[k] = first[k] + dx[k] * (bx - x0) + dy[k] * (by - y0);
-                const int64_t sx = dx[k] * (nx - 1), sy = dy[k] * (ny - 1);
+                e[k] = first[k] + dx[k] * (px0 - x0) + dy[k] * (py0 - y0);
+                const int64_t sx = dx[k] * (px1 - px0), sy = dy[k] * (py1 - py0);
                 const int64_t low = e[k] + std::min<int64_t>(0, sx) + std::min<int64_t>(0, sy);
                 const int64_t high = e[k] + std::max<int64_t>(0, sx) + std::max<int64_t>(0, sy);
                 outside = outside || high < 0;
@@ -221,17 +227,22 @@ int64_t rasterizeTriangleBlocks(FixedPoint2 v0, FixedPoint2 v1, FixedPoint2 v2, 
             }
             if (outside) continue;
             if (inside) {
-                for (int64_t y = by; y < by + ny; ++y)
-                    for (int64_t x = bx; x < bx + nx; ++x) covered(int(x), int(y));
+                count += size_t((px1 - px0 + 1) * (py1 - py0 + 1));
+                for (int64_t y = py0; y <= py1; ++y)
+                    for (int64_t x = px0; x <= px1; ++x) covered(int(x), int(y));
                 continue;
             }
-            for (int64_t y = by; y < by + ny; ++y, e[0] += dy[0], e[1] += dy[1], e[2] += dy[2]) {
+            for (int64_t y = py0; y <= py1; ++y, e[0] += dy[0], e[1] += dy[1], e[2] += dy[2]) {
                 int64_t e0 = e[0], e1 = e[1], e2 = e[2];
-                for (int64_t x = bx; x < bx + nx; ++x, e0 += dx[0], e1 += dx[1], e2 += dx[2])
-                    if ((e0 | e1 | e2) >= 0) covered(int(x), int(y));
+                for (int64_t x = px0; x <= px1; ++x, e0 += dx[0], e1 += dx[1], e2 += dx[2]) {
+                    if ((e0 | e1 | e2) < 0) continue;  // a sign bit: outside an edge
+                    ++count;
+                    covered(int(x), int(y));
+                }
             }
         }
     }
+    fragments += count;
     return area;
 }
 

@@ -603,6 +603,39 @@ TEST_SUITE("hard cases 06") {
                           });
         CHECK(pixels.empty());
     }
+    TEST_CASE("the block rasterizer covers exactly the per-pixel loop's pixels") {
+        // Random triangles, large and small, some with corners on pixel centres (edges
+        // through centres: the fill rule decides), partly off screen, both windings.
+        std::mt19937 rng(6);
+        std::uniform_real_distribution<double> coordinate(-20.0, 60.0), size(0.2, 40.0);
+        const int w = 41, h = 37;
+        for (int n = 0; n < 400; ++n) {
+            double cx = coordinate(rng), cy = coordinate(rng), r = size(rng);
+            FixedPoint2 v[3];
+            for (FixedPoint2& p : v) {
+                double x = cx + r * (coordinate(rng) - 20.0) / 40.0,
+                       y = cy + r * (coordinate(rng) - 20.0) / 40.0;
+                if (n % 3 == 0) x = std::floor(x) + 0.5, y = std::floor(y) + 0.5;
+                p = at(x, y);
+            }
+            for (bool cull : {false, true}) {
+                std::vector<int> simple(size_t(w * h), 0), blocks(size_t(w * h), 0);
+                int64_t a = rasterizeTriangle(
+                    v[0], v[1], v[2], w, h, cull,
+                    [&](int x, int y, const glm::dvec3&) { ++simple[size_t(y * w + x)]; });
+                size_t fragments = 0;
+                int64_t b =
+                    rasterizeTriangleBlocks(v[0], v[1], v[2], w, h, cull, fragments,
+                                            [&](int x, int y) { ++blocks[size_t(y * w + x)]; });
+                INFO("triangle " << n << (cull ? ", back faces culled" : ""));
+                CHECK(a == b);
+                CHECK(simple == blocks);
+                size_t covered = 0;
+                for (int c : simple) covered += size_t(c);
+                CHECK(fragments == covered);
+            }
+        }
+    }
     TEST_CASE("hard case: duplicate triangles tie in the z-buffer and the first one wins") {
         Scene s;
         s.name = "duplicates";

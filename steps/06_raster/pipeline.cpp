@@ -163,12 +163,19 @@ FrameStats rasterizeFrame(const RasterScene& scene, const Camera& camera,
         for (size_t k = 0; k < scene.positions.size(); ++k)
             buffers.clipPositions[k] = transform(uint32_t(k));
     }
-    // What a fan triangle's pixels need of its corners: their unsnapped screen positions,
-    // their w and its reciprocal, and the doubled area.
+    // What a fan triangle's pixels need of its corners: their unsnapped screen positions
+    // and w, and the screen weights as affine functions of the pixel: their values at the
+    // centre of the pixel (x, y) holding corner 0 and their steps per pixel to the right
+    // and down (Pineda 1988, as the edge functions), so that a pixel's weights cost two
+    // multiplications and an addition each.
     struct Corners {
         glm::dvec2 exact[3];
         glm::dvec3 w, inverseW;
-        double area = 0.0, inverseArea = 0.0;
+        int x = 0, y = 0;
+        glm::dvec3 at{0.0}, right{0.0}, down{0.0};
+        glm::dvec3 screenWeights(int px, int py) const {
+            return at + double(py - y) * down + double(px - x) * right;
+        }
     };
     auto cross = [](glm::dvec2 a, glm::dvec2 b) { return a.x * b.y - a.y * b.x; };
     auto setUp = [&](const Vec4d* clip[3], Corners& c) {
@@ -177,48 +184,40 @@ FrameStats rasterizeFrame(const RasterScene& scene, const Camera& camera,
             c.w[i] = clip[i]->w;
         }
         c.inverseW = 1.0 / c.w;
-        c.area = cross(c.exact[1] - c.exact[0], c.exact[2] - c.exact[0]);
+        const glm::dvec2* e = c.exact;
+        double area = cross(e[1] - e[0], e[2] - e[0]);
         // Too thin unsnapped: the snapped corners (exact in double) give the weights.
-        if (!(std::abs(c.area) > 1e-9)) {
+        if (!(std::abs(area) > 1e-9)) {
             for (int i = 0; i < 3; ++i) {
                 FixedPoint2 f = snapToSubpixel(c.exact[i].x, c.exact[i].y);
                 c.exact[i] = glm::dvec2(double(f.x), double(f.y)) / double(kSubpixelOne);
             }
-            c.area = cross(c.exact[1] - c.exact[0], c.exact[2] - c.exact[0]);
+            area = cross(e[1] - e[0], e[2] - e[0]);
         }
-        c.inverseArea = 1.0 / c.area;  // a multiplication per pixel instead of a division
+        // Weight i is E(e[i+1], e[i+2], p) / area; from the unsnapped corners, so snapping
+        // moves edges by at most 1/512 pixel but never tilts the interpolated plane.
+        c.x = int(std::floor(e[0].x));
+        c.y = int(std::floor(e[0].y));
+        const glm::dvec2 p(double(c.x) + 0.5, double(c.y) + 0.5);
+        for (int i = 0; i < 3; ++i) {
+            const glm::dvec2 a = e[(i + 1) % 3], edge = e[(i + 2) % 3] - a;
+            c.at[i] = cross(edge, p - a) / area;
+            c.right[i] = -edge.y / area;
+            c.down[i] = edge.x / area;
+        }
     };
-    // The screen weights of a pixel centre: affine in screen space, from the unsnapped
-    // corners, so snapping moves edges by at most 1/512 pixel but never tilts the plane.
-    auto screenWeights = [&](const Corners& c, int x, int y) {
-        glm::dvec2 p(double(x) + 0.5, double(y) + 0.5);
-        const glm::dvec2* e = c.exact;
-        return glm::dvec3(cross(e[2] - e[1], p - e[1]), cross(e[0] - e[2], p - e[2]),
-                          cross(e[1] - e[0], p - e[0])) *
-               c.inverseArea;
-    };
-    // 1/w is affine in screen space too (it is dot(screen weights, 1/w_i)): its value at the
-    // centre of the pixel holding corner 0 and its steps per pixel, so a fragment's depth
-    // costs two multiplications and one division.
+    // 1/w is affine in screen space too (the screen weights dotted with the corners' 1/w),
+    // so a fragment's depth costs two multiplications and one division.
     struct InversePlane {
         int x = 0, y = 0;
-        double at = 0.0, dx = 0.0, dy = 0.0;
+        double at = 0.0, right = 0.0, down = 0.0;
         double operator()(int px, int py) const {
-            return at + double(py - y) * dy + double(px - x) * dx;  // a row's part first
+            return at + double(py - y) * down + double(px - x) * right;
         }
     };
-    auto inversePlane = [&](const Corners& c) {
-        InversePlane p;
-        const glm::dvec2* e = c.exact;
-        p.x = int(std::floor(e[0].x));
-        p.y = int(std::floor(e[0].y));
-        p.at = glm::dot(screenWeights(c, p.x, p.y), c.inverseW);
-        for (int i = 0; i < 3; ++i) {
-            glm::dvec2 edge = e[(i + 2) % 3] - e[(i + 1) % 3];
-            p.dx -= edge.y * c.inverseW[i] / c.area;
-            p.dy += edge.x * c.inverseW[i] / c.area;
-        }
-        return p;
+    auto inversePlane = [](const Corners& c) {
+        return InversePlane{c.x, c.y, glm::dot(c.at, c.inverseW), glm::dot(c.right, c.inverseW),
+                            glm::dot(c.down, c.inverseW)};
     };
 
     // Deferred attributes (a visibility buffer, Burns, Hunt 2013): a fragment that passes
@@ -364,7 +363,7 @@ FrameStats rasterizeFrame(const RasterScene& scene, const Camera& camera,
                     wholeOf = t;
                 }
                 const Corners& c = piece ? piece->corners : whole;
-                const glm::dvec3 screen = screenWeights(c, x, y);
+                const glm::dvec3 screen = c.screenWeights(x, y);
                 glm::dvec3 l =
                     settings.perspectiveCorrect ? perspectiveCorrectWeights(screen, c.w) : screen;
                 if (piece)

@@ -624,9 +624,11 @@ TEST_SUITE("hard cases 06") {
                     v[0], v[1], v[2], w, h, cull,
                     [&](int x, int y, const glm::dvec3&) { ++simple[size_t(y * w + x)]; });
                 size_t fragments = 0;
-                int64_t b =
-                    rasterizeTriangleBlocks(v[0], v[1], v[2], w, h, cull, fragments,
-                                            [&](int x, int y) { ++blocks[size_t(y * w + x)]; });
+                int64_t b = rasterizeTriangleBlocks(v[0], v[1], v[2], w, h, cull, fragments,
+                                                    [&](int y, int x0, int x1) {
+                                                        for (int x = x0; x <= x1; ++x)
+                                                            ++blocks[size_t(y * w + x)];
+                                                    });
                 INFO("triangle " << n << (cull ? ", back faces culled" : ""));
                 CHECK(a == b);
                 CHECK(simple == blocks);

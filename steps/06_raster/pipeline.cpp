@@ -301,29 +301,42 @@ FrameStats rasterizeFrame(const RasterScene& scene, const Camera& camera,
             const size_t stride = size_t(width);
             const uint32_t id = uint32_t(t);
             uint32_t* const pieceBuffer = buffers.piece.data();
-            auto fragment = [=](int x, int y, double inverseW) {
-                const size_t i = size_t(y) * stride + size_t(x);
-                if (behind(inverseW, depthBuffer[i])) return;  // the division saved
+            auto fragment = [=](size_t i, double inverseW) {
                 if (!depthTest(depthBuffer[i], float(1.0 / inverseW)) || !pieceBuffer) return;
                 triangleBuffer[i] = id;
                 pieceBuffer[i] = piece;
             };
-            // Per pixel, the corners again (the vertex work's lesson), else the plane.
-            auto again = [&](int x, int y) {
-                Vec4d p[3] = {transform(tri[0]), transform(tri[1]), transform(tri[2])};
-                const Vec4d* q[3] = {&p[0], &p[1], &p[2]};
-                Corners c;
-                setUp(q, c);
-                fragment(x, y, inversePlane(c)(x, y));
+            // A run of pixels in a row: first 1/w for all of them and which are certainly
+            // behind (loops without calls, so the compiler can use SIMD), then the rest.
+            auto run = [=](int y, int x0, int x1) {
+                double inverseW[kRasterBlock];
+                bool test[kRasterBlock];
+                const int n = x1 - x0 + 1;
+                const size_t i = size_t(y) * stride + size_t(x0);
+                for (int j = 0; j < n; ++j) inverseW[j] = plane(x0 + j, y);
+                for (int j = 0; j < n; ++j) test[j] = !behind(inverseW[j], depthBuffer[i + j]);
+                for (int j = 0; j < n; ++j)
+                    if (test[j]) fragment(i + size_t(j), inverseW[j]);
+            };
+            // Per pixel, the corners again (the vertex work's lesson).
+            auto again = [&](int y, int x0, int x1) {
+                for (int x = x0; x <= x1; ++x) {
+                    Vec4d p[3] = {transform(tri[0]), transform(tri[1]), transform(tri[2])};
+                    const Vec4d* q[3] = {&p[0], &p[1], &p[2]};
+                    Corners c;
+                    setUp(q, c);
+                    const double inverseW = inversePlane(c)(x, y);
+                    const size_t i = size_t(y) * stride + size_t(x);
+                    if (!behind(inverseW, depthBuffer[i])) fragment(i, inverseW);
+                }
             };
             // Coverage from the snapped (exact integer) edge functions, depth from the
             // unsnapped corners.
             const int64_t area =
                 perPixel ? rasterizeTriangleBlocks(s[0], s[1], s[2], width, height,
                                                    settings.backfaceCulling, fragments, again)
-                         : rasterizeTriangleBlocks(
-                               s[0], s[1], s[2], width, height, settings.backfaceCulling, fragments,
-                               [=](int x, int y) { fragment(x, y, plane(x, y)); });
+                         : rasterizeTriangleBlocks(s[0], s[1], s[2], width, height,
+                                                   settings.backfaceCulling, fragments, run);
             drawn = drawn || area < 0 || (area > 0 && !settings.backfaceCulling);
         }
         if (drawn)

@@ -175,8 +175,9 @@ int64_t rasterizeTriangle(FixedPoint2 v0, FixedPoint2 v1, FixedPoint2 v2, int wi
 // smallest and largest at the block's corners: a block with all corners outside one edge is
 // skipped, one with all corners inside every edge is covered without a test per pixel
 // (trivial reject and accept: McCool, Wales, Moule 2001; Abrash 2009), exact in integers.
-// Calls covered(x, y) for every covered pixel centre, block by block (each pixel once; the
-// order does not matter); `fragments` grows by their number. Returns the signed area as
+// Calls covered(y, x0, x1) for every run of covered pixel centres x0..x1 in a block's row
+// (a row meets the convex triangle in one run), block by block: each pixel once, in no
+// fixed order. `fragments` grows by their number. Returns the signed area as
 // rasterizeTriangle does.
 constexpr int kRasterBlock = 8;
 template <typename Covered>
@@ -228,17 +229,19 @@ int64_t rasterizeTriangleBlocks(FixedPoint2 v0, FixedPoint2 v1, FixedPoint2 v2, 
             if (outside) continue;
             if (inside) {
                 count += size_t((px1 - px0 + 1) * (py1 - py0 + 1));
-                for (int64_t y = py0; y <= py1; ++y)
-                    for (int64_t x = px0; x <= px1; ++x) covered(int(x), int(y));
+                for (int64_t y = py0; y <= py1; ++y) covered(int(y), int(px0), int(px1));
                 continue;
             }
             for (int64_t y = py0; y <= py1; ++y, e[0] += dy[0], e[1] += dy[1], e[2] += dy[2]) {
-                int64_t e0 = e[0], e1 = e[1], e2 = e[2];
+                int64_t e0 = e[0], e1 = e[1], e2 = e[2], first = -1, last = -2;
                 for (int64_t x = px0; x <= px1; ++x, e0 += dx[0], e1 += dx[1], e2 += dx[2]) {
                     if ((e0 | e1 | e2) < 0) continue;  // a sign bit: outside an edge
-                    ++count;
-                    covered(int(x), int(y));
+                    if (first < 0) first = x;
+                    last = x;
                 }
+                if (first < 0) continue;
+                count += size_t(last - first + 1);
+                covered(int(y), int(first), int(last));
             }
         }
     }

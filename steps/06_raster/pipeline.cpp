@@ -199,11 +199,12 @@ FrameStats rasterizeFrame(const RasterScene& scene, const Camera& camera,
         c.x = int(std::floor(e[0].x));
         c.y = int(std::floor(e[0].y));
         const glm::dvec2 p(double(c.x) + 0.5, double(c.y) + 0.5);
+        const double inverseArea = 1.0 / area;
         for (int i = 0; i < 3; ++i) {
             const glm::dvec2 a = e[(i + 1) % 3], edge = e[(i + 2) % 3] - a;
-            c.at[i] = cross(edge, p - a) / area;
-            c.right[i] = -edge.y / area;
-            c.down[i] = edge.x / area;
+            c.at[i] = cross(edge, p - a) * inverseArea;
+            c.right[i] = -edge.y * inverseArea;
+            c.down[i] = edge.x * inverseArea;
         }
     };
     // 1/w is affine in screen space too (the screen weights dotted with the corners' 1/w),

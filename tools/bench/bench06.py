@@ -91,11 +91,11 @@ def verdict(row, pixels):
         culling = ("; the frustum culling costs more than it saves here (without it, "
                    "visibility at x%.2f)" % row["no_culling_ratio"])
     return ("%s: target missed: step 06 %s. In the way: the work per pixel centre covered "
-            "(%d of them, %.1f per pixel; %.0f ns each in the unculled frame: every pixel of "
-            "each triangle's bounding box visited, then 1/w and the perspective-correct "
-            "weights in double precision, one pixel at a time), where "
-            "llvmpipe rejects and accepts whole blocks of pixels and shades 4x4 blocks with "
-            "SIMD in JIT-compiled code; culling kept %d of %d triangles%s"
+            "(%d of them, %.1f per pixel; %.0f ns each in the unculled frame: per fragment a "
+            "division for its depth and a call of the exercise's depthTest, per visible "
+            "pixel the perspective-correct weights in double precision, one pixel at a "
+            "time), where llvmpipe tests and writes 4x4 blocks of fragments with SIMD in "
+            "JIT-compiled code; culling kept %d of %d triangles%s"
             % (row["mesh"], " and ".join(parts), row["fragments"], row["fragments"] / pixels,
                ns, row["triangles_after_culling"], row["triangles"], culling))
 

@@ -301,7 +301,8 @@ FrameStats rasterizeFrame(const RasterScene& scene, const Camera& camera,
             // piece. What it reads is copied in, so that the compiler keeps it in registers.
             const size_t stride = size_t(width);
             const uint32_t id = uint32_t(t);
-            uint32_t* const pieceBuffer = buffers.piece.data();
+            // None in a depth-only frame (the buffers may keep an earlier frame's memory).
+            uint32_t* const pieceBuffer = settings.depthOnly ? nullptr : buffers.piece.data();
             auto fragment = [=](size_t i, double inverseW) {
                 if (!depthTest(depthBuffer[i], float(1.0 / inverseW)) || !pieceBuffer) return;
                 triangleBuffer[i] = id;

@@ -653,6 +653,26 @@ TEST_SUITE("hard cases 06") {
         CHECK(stats.pixelsCovered > 50);
         for (uint32_t id : b.triangle) CHECK((id == kNoPrimitive || id == 0));
     }
+    TEST_CASE("hard case: a larger depth-only frame in buffers that drew a full frame") {
+        Scene s;
+        s.name = "one";
+        s.mesh.positions = {{-1, -1, 0}, {1, -1, 0}, {0, 1, 0}};
+        s.mesh.triangles = {{0, 1, 2}};
+        s.mesh.computeVertexNormals();
+        RasterScene raster = RasterScene::fromScene(s);
+        Camera c = Camera::lookingAt(Vec3(0, 0, 3), Vec3(0, 0, 0), Vec3(0, 1, 0), 60.0f, 1.0f);
+        RasterSettings rs;
+        rs.width = rs.height = 16;
+        FrameBuffers b, fresh;
+        rasterizeFrame(raster, c, rs, b);
+        rs.width = rs.height = 64;
+        rs.depthOnly = true;
+        FrameStats again = rasterizeFrame(raster, c, rs, b);
+        rasterizeFrame(raster, c, rs, fresh);
+        CHECK(again.pixelsCovered > 500);
+        CHECK(b.triangle.empty());
+        CHECK(b.depth == fresh.depth);
+    }
     TEST_CASE("hard case: a mesh with a NaN coordinate is refused with a clear message") {
         Scene s;
         s.name = "nan";

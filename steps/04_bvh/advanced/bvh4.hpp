@@ -505,12 +505,25 @@ inline uint32_t intersectLeafPackets(Axes axes, const WatertightRay& r, const Wa
             tClosest = _mm_cvtss_f32(m);
             nearest = base + uint32_t(lane);
         }
+        // Diffuse rays start on a triangle: its t is about 0, out of the normal range, so
+        // most of them meet one such lane. The lane's triangle is read from the packet (in
+        // the cache, the same floats as leafTriangles[slot], which is not), and a lane
+        // without a zero edge function goes straight to the double test, as the scalar
+        // test would with these u, v, w and det.
         int scalarMask = _mm_movemask_ps(scalar) & live;
+        const int zeroMask = _mm_movemask_ps(anyZero);
         while (scalarMask != 0) [[unlikely]] {
-                uint32_t slot = base + uint32_t(std::countr_zero(unsigned(scalarMask)));
+                const int lane = std::countr_zero(unsigned(scalarMask));
                 scalarMask &= scalarMask - 1;
-                if (intersectLeafTriangle(axes, r, bvh.leafTriangles[slot], tClosest))
-                    nearest = slot;
+                const LeafTriangle tri{
+                    Vec3(p.vertex[0][0][lane], p.vertex[0][1][lane], p.vertex[0][2][lane]),
+                    Vec3(p.vertex[1][0][lane], p.vertex[1][1][lane], p.vertex[1][2][lane]),
+                    Vec3(p.vertex[2][0][lane], p.vertex[2][1][lane], p.vertex[2][2][lane])};
+                const bool hitLane =
+                    (zeroMask >> lane & 1)
+                        ? intersectLeafTriangle(axes, r, tri, tClosest)
+                        : intersectLeafTriangleDouble(axes, r, tri, tClosest, nullptr, nullptr);
+                if (hitLane) nearest = base + uint32_t(lane);
             }
     }
 #else

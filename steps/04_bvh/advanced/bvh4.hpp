@@ -433,7 +433,23 @@ struct WatertightRay4 {
 #endif
 };
 
-template <typename Axes, int W>
+#if defined(BOXES_TARGET_AVX2)
+// The double test from AVX code. It is compiled for baseline x86-64, and its SSE
+// instructions, run while the upper halves of the registers are in use, stalled (most of
+// its samples on its first instruction): vzeroupper right before the call clears them (a
+// vzeroupper further up is undone, e.g. by a 256-bit copy of the triangle).
+template <typename Axes>
+[[gnu::target("avx2")]] inline bool intersectLeafTriangleDoubleFromAvx(Axes axes,
+                                                                       const WatertightRay& r,
+                                                                       const LeafTriangle& tri,
+                                                                       float& tmax) {
+    _mm256_zeroupper();
+    return intersectLeafTriangleDouble(axes, r, tri, tmax, nullptr, nullptr);
+}
+#endif
+
+// kAvx: only from code compiled for AVX2 (the batch tracers' AVX2 loop).
+template <bool kAvx = false, typename Axes, int W>
 inline uint32_t intersectLeafPackets(Axes axes, const WatertightRay& r, const WatertightRay4& r4,
                                      const BvhWide<W>& bvh, uint32_t first, uint32_t count,
                                      float& tClosest) {
@@ -519,10 +535,18 @@ inline uint32_t intersectLeafPackets(Axes axes, const WatertightRay& r, const Wa
                     Vec3(p.vertex[0][0][lane], p.vertex[0][1][lane], p.vertex[0][2][lane]),
                     Vec3(p.vertex[1][0][lane], p.vertex[1][1][lane], p.vertex[1][2][lane]),
                     Vec3(p.vertex[2][0][lane], p.vertex[2][1][lane], p.vertex[2][2][lane])};
-                const bool hitLane =
-                    (zeroMask >> lane & 1)
-                        ? intersectLeafTriangle(axes, r, tri, tClosest)
-                        : intersectLeafTriangleDouble(axes, r, tri, tClosest, nullptr, nullptr);
+                bool hitLane;
+                if (zeroMask >> lane & 1) {
+                    hitLane = intersectLeafTriangle(axes, r, tri, tClosest);
+                } else {
+#if defined(BOXES_TARGET_AVX2)
+                    if constexpr (kAvx)
+                        hitLane = intersectLeafTriangleDoubleFromAvx(axes, r, tri, tClosest);
+                    else
+#endif
+                        hitLane =
+                            intersectLeafTriangleDouble(axes, r, tri, tClosest, nullptr, nullptr);
+                }
                 if (hitLane) nearest = base + uint32_t(lane);
             }
     }
@@ -549,7 +573,8 @@ inline TraceHit traceNearest(const BvhWide<W>& bvh, const Ray& ray, Counter coun
             [&](uint32_t first, uint32_t count, float& tmax) {
                 counter.leaf((count + 3) / 4);
                 counter.triangles(count);
-                return intersectLeafPackets(axes, watertight, watertight4, bvh, first, count, tmax);
+                return intersectLeafPackets<kAvx>(axes, watertight, watertight4, bvh, first, count,
+                                                  tmax);
             },
             counter);
     });

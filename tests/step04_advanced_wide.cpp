@@ -57,8 +57,10 @@ void checkStructure4(const BvhWide<W>& wide, size_t primitives) {
                     uint32_t p = wide.primitiveIndices[s];
                     REQUIRE(p < primitives);
                     ++seen[p];
-                    if (!wide.packets.empty())  // the packet holds the slot's triangle
+                    if (!wide.packets.empty()) {  // the packet holds the slot's triangle
                         CHECK(wide.packets[s / 4].vertex[2][1][s % 4] == wide.leafTriangles[s].c.y);
+                        CHECK(wide.packets[s / 4].primitive[s % 4] == p);
+                    }
                 }
             } else {
                 REQUIRE(node.child[i] > index);

@@ -120,6 +120,7 @@ struct Collapser {
             for (int v = 0; v < 3; ++v)
                 for (int axis = 0; axis < 3; ++axis)
                     packet.vertex[v][axis][i % 4] = (*vertices[v])[axis];
+            packet.primitive[i % 4] = binary.primitiveIndices[slot];
             wide.leafTriangles.push_back(tri);
         }
         return first;

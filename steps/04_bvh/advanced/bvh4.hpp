@@ -62,10 +62,15 @@ using Bvh8Node = BvhWideNode<8>;
 static_assert(sizeof(Bvh4Node) == 128, "two 64-byte cache lines");
 static_assert(sizeof(Bvh8Node) == 256, "four 64-byte cache lines");
 
-// Four triangles "structure of arrays" (vertex, axis, lane) for the 4-triangle leaf test.
-struct alignas(16) TrianglePacket4 {
+// Four triangles "structure of arrays" (vertex, axis, lane) for the 4-triangle leaf test,
+// and their primitives: a hit's primitive is then on a line the test has read, where in
+// primitiveIndices it was a miss at the end of most diffuse rays. 160 bytes aligned to 32:
+// three cache lines, as the 144 bytes without the primitives.
+struct alignas(32) TrianglePacket4 {
     float vertex[3][3][4];
+    uint32_t primitive[4];  // the same as primitiveIndices[4 * packet + lane]
 };
+static_assert(sizeof(TrianglePacket4) == 160, "three cache lines at 32-byte alignment");
 
 // Slots are regrouped by four: every leaf starts a packet (slot first = 4 * packet), and
 // the lanes after a leaf's last triangle repeat that triangle (same primitive index), so
@@ -433,7 +438,23 @@ struct WatertightRay4 {
 #endif
 };
 
-template <typename Axes, int W>
+#if defined(BOXES_TARGET_AVX2)
+// The double test from AVX code. It is compiled for baseline x86-64, and its SSE
+// instructions, run while the upper halves of the registers are in use, stalled (most of
+// its samples on its first instruction): vzeroupper right before the call clears them (a
+// vzeroupper further up is undone, e.g. by a 256-bit copy of the triangle).
+template <typename Axes>
+[[gnu::target("avx2")]] inline bool intersectLeafTriangleDoubleFromAvx(Axes axes,
+                                                                       const WatertightRay& r,
+                                                                       const LeafTriangle& tri,
+                                                                       float& tmax) {
+    _mm256_zeroupper();
+    return intersectLeafTriangleDouble(axes, r, tri, tmax, nullptr, nullptr);
+}
+#endif
+
+// kAvx: only from code compiled for AVX2 (the batch tracers' AVX2 loop).
+template <bool kAvx = false, typename Axes, int W>
 inline uint32_t intersectLeafPackets(Axes axes, const WatertightRay& r, const WatertightRay4& r4,
                                      const BvhWide<W>& bvh, uint32_t first, uint32_t count,
                                      float& tClosest) {
@@ -505,12 +526,33 @@ inline uint32_t intersectLeafPackets(Axes axes, const WatertightRay& r, const Wa
             tClosest = _mm_cvtss_f32(m);
             nearest = base + uint32_t(lane);
         }
+        // Diffuse rays start on a triangle: its t is about 0, out of the normal range, so
+        // most of them meet one such lane. The lane's triangle is read from the packet (in
+        // the cache, the same floats as leafTriangles[slot], which is not), and a lane
+        // without a zero edge function goes straight to the double test, as the scalar
+        // test would with these u, v, w and det.
         int scalarMask = _mm_movemask_ps(scalar) & live;
+        const int zeroMask = _mm_movemask_ps(anyZero);
         while (scalarMask != 0) [[unlikely]] {
-                uint32_t slot = base + uint32_t(std::countr_zero(unsigned(scalarMask)));
+                const int lane = std::countr_zero(unsigned(scalarMask));
                 scalarMask &= scalarMask - 1;
-                if (intersectLeafTriangle(axes, r, bvh.leafTriangles[slot], tClosest))
-                    nearest = slot;
+                const LeafTriangle tri{
+                    Vec3(p.vertex[0][0][lane], p.vertex[0][1][lane], p.vertex[0][2][lane]),
+                    Vec3(p.vertex[1][0][lane], p.vertex[1][1][lane], p.vertex[1][2][lane]),
+                    Vec3(p.vertex[2][0][lane], p.vertex[2][1][lane], p.vertex[2][2][lane])};
+                bool hitLane;
+                if (zeroMask >> lane & 1) {
+                    hitLane = intersectLeafTriangle(axes, r, tri, tClosest);
+                } else {
+#if defined(BOXES_TARGET_AVX2)
+                    if constexpr (kAvx)
+                        hitLane = intersectLeafTriangleDoubleFromAvx(axes, r, tri, tClosest);
+                    else
+#endif
+                        hitLane =
+                            intersectLeafTriangleDouble(axes, r, tri, tClosest, nullptr, nullptr);
+                }
+                if (hitLane) nearest = base + uint32_t(lane);
             }
     }
 #else
@@ -536,12 +578,13 @@ inline TraceHit traceNearest(const BvhWide<W>& bvh, const Ray& ray, Counter coun
             [&](uint32_t first, uint32_t count, float& tmax) {
                 counter.leaf((count + 3) / 4);
                 counter.triangles(count);
-                return intersectLeafPackets(axes, watertight, watertight4, bvh, first, count, tmax);
+                return intersectLeafPackets<kAvx>(axes, watertight, watertight4, bvh, first, count,
+                                                  tmax);
             },
             counter);
     });
     if (slot == kTraversalMiss) return {};
-    return {tClosest, bvh.primitiveIndices[slot]};
+    return {tClosest, bvh.packets[slot / 4].primitive[slot % 4]};
 }
 
 // The batch loop's nearest hit (batch.hpp).

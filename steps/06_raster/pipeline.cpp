@@ -224,14 +224,18 @@ FrameStats rasterizeFrame(const RasterScene& scene, const Camera& camera,
     // Deferred attributes (a visibility buffer, Burns, Hunt 2013): a fragment that passes
     // the depth test stores its triangle and which fan piece drew it; the weights are
     // computed once per visible pixel after the last triangle, not for every fragment that
-    // is later overdrawn. A piece is kept for clipped triangles (and, when the vertex work
-    // is not done once per vertex, for all of them); the others are read back from the
-    // triangle's clip positions.
-    struct Piece {
-        Corners corners;
-        glm::dvec3 weights[3];  // of the original triangle's vertices, at the piece's corners
+    // is later overdrawn. A piece that won a fragment keeps what the resolve needs (its
+    // screen weights' affine set-up and w), so the resolve reads one record per pixel
+    // instead of setting the triangle's corners up again. A clipped triangle's piece (and,
+    // when the vertex work is not done once per vertex, every piece) also keeps its
+    // corners' weights of the original triangle's vertices.
+    struct Drawn {
+        glm::dvec3 at, right, down, w;
+        int x = 0, y = 0;
+        uint32_t weights = 0;  // in cornerWeights, or kWholeTriangle
     };
-    std::vector<Piece> pieces;
+    std::vector<Drawn> drawnPieces;
+    std::vector<std::array<glm::dvec3, 3>> cornerWeights;
     constexpr uint32_t kWholeTriangle = ~uint32_t(0);
     float* const depthBuffer = buffers.depth.data();
     uint32_t* const triangleBuffer = buffers.triangle.data();
@@ -292,21 +296,19 @@ FrameStats rasterizeFrame(const RasterScene& scene, const Camera& camera,
             for (int i = 0; i < 3; ++i)
                 s[i] = snapToSubpixel(corners.exact[i].x, corners.exact[i].y);
             const InversePlane plane = inversePlane(corners);
-            uint32_t piece = kWholeTriangle;
-            if (!inside || work != VertexWork::OncePerVertex) {
-                piece = uint32_t(pieces.size());
-                pieces.push_back({corners, {v[0]->weights, v[1]->weights, v[2]->weights}});
-            }
+            const uint32_t piece = uint32_t(drawnPieces.size());
+            bool won = false;  // a fragment passed the depth test: the piece is kept
             // A fragment's work: the depth test, then for the resolve the triangle and the
             // piece. What it reads is copied in, so that the compiler keeps it in registers.
             const size_t stride = size_t(width);
             const uint32_t id = uint32_t(t);
             // None in a depth-only frame (the buffers may keep an earlier frame's memory).
             uint32_t* const pieceBuffer = settings.depthOnly ? nullptr : buffers.piece.data();
-            auto fragment = [=](size_t i, double inverseW) {
+            auto fragment = [=, &won](size_t i, double inverseW) {
                 if (!depthTest(depthBuffer[i], float(1.0 / inverseW)) || !pieceBuffer) return;
                 triangleBuffer[i] = id;
                 pieceBuffer[i] = piece;
+                won = true;
             };
             // A run of pixels in a row: first 1/w for all of them and which are certainly
             // behind (loops without calls, so the compiler can use SIMD), then the rest.
@@ -340,6 +342,15 @@ FrameStats rasterizeFrame(const RasterScene& scene, const Camera& camera,
                          : rasterizeTriangleBlocks(s[0], s[1], s[2], width, height,
                                                    settings.backfaceCulling, fragments, run);
             drawn = drawn || area < 0 || (area > 0 && !settings.backfaceCulling);
+            if (won) {
+                uint32_t weights = kWholeTriangle;
+                if (!inside || work != VertexWork::OncePerVertex) {
+                    weights = uint32_t(cornerWeights.size());
+                    cornerWeights.push_back({v[0]->weights, v[1]->weights, v[2]->weights});
+                }
+                drawnPieces.push_back({corners.at, corners.right, corners.down, corners.w,
+                                       corners.x, corners.y, weights});
+            }
         }
         if (drawn)
             ++stats.trianglesDrawn;
@@ -358,31 +369,21 @@ FrameStats rasterizeFrame(const RasterScene& scene, const Camera& camera,
 
     // The resolve: per visible pixel its perspective-correct weights (Heckbert, Moreton
     // 1991), blended from the piece's corners to the original triangle's vertices.
-    // Neighbouring pixels mostly show the same piece, so its corners are set up once per run.
     if (!settings.depthOnly) {
-        Corners whole;
-        uint32_t wholeOf = kNoPrimitive;
         for (int y = 0; y < height; ++y)
             for (int x = 0; x < width; ++x) {
                 const size_t i = buffers.index(x, y);
-                const uint32_t t = triangleBuffer[i];
-                if (t == kNoPrimitive) continue;
-                const uint32_t k = buffers.piece[i];
-                const Piece* piece = k == kWholeTriangle ? nullptr : &pieces[k];
-                if (!piece && t != wholeOf) {
-                    const auto& tri = scene.triangles[t];
-                    const Vec4d* clip[3] = {&buffers.clipPositions[tri[0]],
-                                            &buffers.clipPositions[tri[1]],
-                                            &buffers.clipPositions[tri[2]]};
-                    setUp(clip, whole);
-                    wholeOf = t;
-                }
-                const Corners& c = piece ? piece->corners : whole;
-                const glm::dvec3 screen = c.screenWeights(x, y);
+                if (triangleBuffer[i] == kNoPrimitive) continue;
+                const Drawn& d = drawnPieces[buffers.piece[i]];
+                // As Corners::screenWeights: the same bits.
+                const glm::dvec3 screen =
+                    d.at + double(y - d.y) * d.down + double(x - d.x) * d.right;
                 glm::dvec3 l =
-                    settings.perspectiveCorrect ? perspectiveCorrectWeights(screen, c.w) : screen;
-                if (piece)
-                    l = l.x * piece->weights[0] + l.y * piece->weights[1] + l.z * piece->weights[2];
+                    settings.perspectiveCorrect ? perspectiveCorrectWeights(screen, d.w) : screen;
+                if (d.weights != kWholeTriangle) {
+                    const auto& q = cornerWeights[d.weights];
+                    l = l.x * q[0] + l.y * q[1] + l.z * q[2];
+                }
                 buffers.weight1[i] = float(l.y);
                 buffers.weight2[i] = float(l.z);
             }

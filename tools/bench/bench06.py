@@ -92,7 +92,7 @@ def verdict(row, pixels):
                    "visibility at x%.2f)" % row["no_culling_ratio"])
     return ("%s: target missed: step 06 %s. In the way: the work per pixel centre covered "
             "(%d of them, %.1f per pixel; %.0f ns each in the unculled frame: per fragment a "
-            "division for its depth and a call of the exercise's depthTest, per visible "
+            "division for its depth and the exercise's depthTest, per visible "
             "pixel the perspective-correct weights in double precision, one pixel at a "
             "time), where llvmpipe tests and writes 4x4 blocks of fragments with SIMD in "
             "JIT-compiled code; culling kept %d of %d triangles%s"

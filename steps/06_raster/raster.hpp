@@ -108,6 +108,25 @@ bool depthTest(float& stored, float incoming);
 // (screen_i / w_i) / sum_j (screen_j / w_j) (Heckbert, Moreton 1991).
 glm::dvec3 perspectiveCorrectWeights(const glm::dvec3& screen, const glm::dvec3& w);
 
+// The pixels whose centres lie in the triangle's bounding box, clipped to the image:
+// columns x0..x1 and rows y0..y1 (empty when x0 > x1 or y0 > y1).
+struct PixelBounds {
+    int64_t x0, y0, x1, y1;
+};
+inline PixelBounds pixelBounds(const FixedPoint2& v0, const FixedPoint2& v1, const FixedPoint2& v2,
+                               int width, int height) {
+    auto first = [](int64_t a, int64_t b, int64_t c) {  // ceil(min - 1/2)
+        return (std::min(a, std::min(b, c)) - kSubpixelOne / 2 + kSubpixelOne - 1) >> kSubpixelBits;
+    };
+    auto last = [](int64_t a, int64_t b, int64_t c) {  // floor(max - 1/2)
+        return (std::max(a, std::max(b, c)) - kSubpixelOne / 2) >> kSubpixelBits;
+    };
+    return {std::max<int64_t>(0, first(v0.x, v1.x, v2.x)),
+            std::max<int64_t>(0, first(v0.y, v1.y, v2.y)),
+            std::min<int64_t>(width - 1, last(v0.x, v1.x, v2.x)),
+            std::min<int64_t>(height - 1, last(v0.y, v1.y, v2.y))};
+}
+
 // The pixels a triangle covers: calls covered(x, y, screenWeights) for every pixel centre
 // inside the triangle under the top-left rule, within [0, width) x [0, height). The
 // vertices may come in either winding; zero area draws nothing. Returns the signed area
@@ -127,18 +146,7 @@ int64_t rasterizeTriangle(FixedPoint2 v0, FixedPoint2 v1, FixedPoint2 v2, int wi
     const int64_t bias0 = isTopLeftEdge(v1, v2) ? 0 : -1;
     const int64_t bias1 = isTopLeftEdge(v2, v0) ? 0 : -1;
     const int64_t bias2 = isTopLeftEdge(v0, v1) ? 0 : -1;
-    auto pixelMin = [](int64_t a, int64_t b, int64_t c) {
-        int64_t m = std::min(a, std::min(b, c));
-        return (m - kSubpixelOne / 2 + kSubpixelOne - 1) >> kSubpixelBits;  // ceil((m - 1/2))
-    };
-    auto pixelMax = [](int64_t a, int64_t b, int64_t c) {
-        int64_t m = std::max(a, std::max(b, c));
-        return (m - kSubpixelOne / 2) >> kSubpixelBits;  // floor(m - 1/2)
-    };
-    int64_t x0 = std::max<int64_t>(0, pixelMin(v0.x, v1.x, v2.x));
-    int64_t y0 = std::max<int64_t>(0, pixelMin(v0.y, v1.y, v2.y));
-    int64_t x1 = std::min<int64_t>(width - 1, pixelMax(v0.x, v1.x, v2.x));
-    int64_t y1 = std::min<int64_t>(height - 1, pixelMax(v0.y, v1.y, v2.y));
+    const auto [x0, y0, x1, y1] = pixelBounds(v0, v1, v2, width, height);
     const double inverseArea = 1.0 / double(positive);
     // An edge function is affine in p: a step of one pixel to the right adds the same
     // amount everywhere, a step down another (Pineda 1988). In integers the sums are exact,
@@ -188,16 +196,7 @@ int64_t rasterizeTriangleBlocks(FixedPoint2 v0, FixedPoint2 v1, FixedPoint2 v2, 
     if (area == 0 || (cullBackFaces && area > 0)) return area;
     if (area < 0) std::swap(v1, v2);
     const FixedPoint2 a[3] = {v1, v2, v0}, b[3] = {v2, v0, v1};  // edge k is opposite vertex k
-    auto pixelMin = [](int64_t p, int64_t q, int64_t r) {
-        return (std::min(p, std::min(q, r)) - kSubpixelOne / 2 + kSubpixelOne - 1) >> kSubpixelBits;
-    };
-    auto pixelMax = [](int64_t p, int64_t q, int64_t r) {
-        return (std::max(p, std::max(q, r)) - kSubpixelOne / 2) >> kSubpixelBits;
-    };
-    const int64_t x0 = std::max<int64_t>(0, pixelMin(v0.x, v1.x, v2.x));
-    const int64_t y0 = std::max<int64_t>(0, pixelMin(v0.y, v1.y, v2.y));
-    const int64_t x1 = std::min<int64_t>(width - 1, pixelMax(v0.x, v1.x, v2.x));
-    const int64_t y1 = std::min<int64_t>(height - 1, pixelMax(v0.y, v1.y, v2.y));
+    const auto [x0, y0, x1, y1] = pixelBounds(v0, v1, v2, width, height);
     if (x0 > x1 || y0 > y1) return area;
     // Per edge: its value at the first pixel centre (with the top-left bias: covered when
     // >= 0) and its steps (Pineda 1988).
@@ -233,15 +232,15 @@ int64_t rasterizeTriangleBlocks(FixedPoint2 v0, FixedPoint2 v1, FixedPoint2 v2, 
                 continue;
             }
             for (int64_t y = py0; y <= py1; ++y, e[0] += dy[0], e[1] += dy[1], e[2] += dy[2]) {
-                int64_t e0 = e[0], e1 = e[1], e2 = e[2], first = -1, last = -2;
+                int64_t e0 = e[0], e1 = e[1], e2 = e[2], runFirst = -1, runLast = -2;
                 for (int64_t x = px0; x <= px1; ++x, e0 += dx[0], e1 += dx[1], e2 += dx[2]) {
                     if ((e0 | e1 | e2) < 0) continue;  // a sign bit: outside an edge
-                    if (first < 0) first = x;
-                    last = x;
+                    if (runFirst < 0) runFirst = x;
+                    runLast = x;
                 }
-                if (first < 0) continue;
-                count += size_t(last - first + 1);
-                covered(int(y), int(first), int(last));
+                if (runFirst < 0) continue;
+                count += size_t(runLast - runFirst + 1);
+                covered(int(y), int(runFirst), int(runLast));
             }
         }
     }

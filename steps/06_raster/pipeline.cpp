@@ -22,6 +22,18 @@ void addTriangle(RasterScene& s, uint32_t a, uint32_t b, uint32_t c, int materia
     s.object.push_back(object);
 }
 
+// A quantity affine in the pixel (the screen weights, 1/w): its value at the centre of
+// pixel (x, y) and its steps per pixel to the right and down (Pineda 1988, as the edge
+// functions), so a pixel's value costs two multiplications and an addition.
+template <typename T>
+struct AffineInPixel {
+    int x = 0, y = 0;
+    T at{0.0}, right{0.0}, down{0.0};
+    T operator()(int px, int py) const {
+        return at + double(py - y) * down + double(px - x) * right;
+    }
+};
+
 }  // namespace
 
 RasterScene RasterScene::fromScene(const Scene& scene, int sphereSegments) {
@@ -164,18 +176,12 @@ FrameStats rasterizeFrame(const RasterScene& scene, const Camera& camera,
             buffers.clipPositions[k] = transform(uint32_t(k));
     }
     // What a fan triangle's pixels need of its corners: their unsnapped screen positions
-    // and w, and the screen weights as affine functions of the pixel: their values at the
-    // centre of the pixel (x, y) holding corner 0 and their steps per pixel to the right
-    // and down (Pineda 1988, as the edge functions), so that a pixel's weights cost two
-    // multiplications and an addition each.
+    // and w, and the screen weights as affine functions of the pixel, from the pixel
+    // holding corner 0.
     struct Corners {
         glm::dvec2 exact[3];
         glm::dvec3 w, inverseW;
-        int x = 0, y = 0;
-        glm::dvec3 at{0.0}, right{0.0}, down{0.0};
-        glm::dvec3 screenWeights(int px, int py) const {
-            return at + double(py - y) * down + double(px - x) * right;
-        }
+        AffineInPixel<glm::dvec3> screen;
     };
     auto cross = [](glm::dvec2 a, glm::dvec2 b) { return a.x * b.y - a.y * b.x; };
     auto setUp = [&](const Vec4d* clip[3], Corners& c) {
@@ -196,29 +202,24 @@ FrameStats rasterizeFrame(const RasterScene& scene, const Camera& camera,
         }
         // Weight i is E(e[i+1], e[i+2], p) / area; from the unsnapped corners, so snapping
         // moves edges by at most 1/512 pixel but never tilts the interpolated plane.
-        c.x = int(std::floor(e[0].x));
-        c.y = int(std::floor(e[0].y));
-        const glm::dvec2 p(double(c.x) + 0.5, double(c.y) + 0.5);
+        AffineInPixel<glm::dvec3>& l = c.screen;
+        l.x = int(std::floor(e[0].x));
+        l.y = int(std::floor(e[0].y));
+        const glm::dvec2 p(double(l.x) + 0.5, double(l.y) + 0.5);
         const double inverseArea = 1.0 / area;
         for (int i = 0; i < 3; ++i) {
             const glm::dvec2 a = e[(i + 1) % 3], edge = e[(i + 2) % 3] - a;
-            c.at[i] = cross(edge, p - a) * inverseArea;
-            c.right[i] = -edge.y * inverseArea;
-            c.down[i] = edge.x * inverseArea;
+            l.at[i] = cross(edge, p - a) * inverseArea;
+            l.right[i] = -edge.y * inverseArea;
+            l.down[i] = edge.x * inverseArea;
         }
     };
     // 1/w is affine in screen space too (the screen weights dotted with the corners' 1/w),
     // so a fragment's depth costs two multiplications and one division.
-    struct InversePlane {
-        int x = 0, y = 0;
-        double at = 0.0, right = 0.0, down = 0.0;
-        double operator()(int px, int py) const {
-            return at + double(py - y) * down + double(px - x) * right;
-        }
-    };
     auto inversePlane = [](const Corners& c) {
-        return InversePlane{c.x, c.y, glm::dot(c.at, c.inverseW), glm::dot(c.right, c.inverseW),
-                            glm::dot(c.down, c.inverseW)};
+        const AffineInPixel<glm::dvec3>& l = c.screen;
+        return AffineInPixel<double>{l.x, l.y, glm::dot(l.at, c.inverseW),
+                                     glm::dot(l.right, c.inverseW), glm::dot(l.down, c.inverseW)};
     };
 
     // Deferred attributes (a visibility buffer, Burns, Hunt 2013): a fragment that passes
@@ -230,8 +231,8 @@ FrameStats rasterizeFrame(const RasterScene& scene, const Camera& camera,
     // when the vertex work is not done once per vertex, every piece) also keeps its
     // corners' weights of the original triangle's vertices.
     struct Drawn {
-        glm::dvec3 at, right, down, w;
-        int x = 0, y = 0;
+        AffineInPixel<glm::dvec3> screen;
+        glm::dvec3 w;
         uint32_t weights = 0;  // in cornerWeights, or kWholeTriangle
     };
     std::vector<Drawn> drawnPieces;
@@ -295,7 +296,7 @@ FrameStats rasterizeFrame(const RasterScene& scene, const Camera& camera,
             FixedPoint2 s[3];
             for (int i = 0; i < 3; ++i)
                 s[i] = snapToSubpixel(corners.exact[i].x, corners.exact[i].y);
-            const InversePlane plane = inversePlane(corners);
+            const AffineInPixel<double> plane = inversePlane(corners);
             const uint32_t piece = uint32_t(drawnPieces.size());
             bool won = false;  // a fragment passed the depth test: the piece is kept
             // A fragment's work: the depth test, then for the resolve the triangle and the
@@ -348,8 +349,7 @@ FrameStats rasterizeFrame(const RasterScene& scene, const Camera& camera,
                     weights = uint32_t(cornerWeights.size());
                     cornerWeights.push_back({v[0]->weights, v[1]->weights, v[2]->weights});
                 }
-                drawnPieces.push_back({corners.at, corners.right, corners.down, corners.w,
-                                       corners.x, corners.y, weights});
+                drawnPieces.push_back({corners.screen, corners.w, weights});
             }
         }
         if (drawn)
@@ -375,9 +375,7 @@ FrameStats rasterizeFrame(const RasterScene& scene, const Camera& camera,
                 const size_t i = buffers.index(x, y);
                 if (triangleBuffer[i] == kNoPrimitive) continue;
                 const Drawn& d = drawnPieces[buffers.piece[i]];
-                // As Corners::screenWeights: the same bits.
-                const glm::dvec3 screen =
-                    d.at + double(y - d.y) * d.down + double(x - d.x) * d.right;
+                const glm::dvec3 screen = d.screen(x, y);
                 glm::dvec3 l =
                     settings.perspectiveCorrect ? perspectiveCorrectWeights(screen, d.w) : screen;
                 if (d.weights != kWholeTriangle) {

@@ -496,14 +496,34 @@ def _signal_name(number):
 
 
 def run(cmd, limits, writable=(), cwd=None, isolate=True, keep=1 << 20, env=None, hidden=(),
-        readable=(), user=None):
+        readable=(), user=None, pass_fds=()):
     """Runs cmd under the sandbox and limits; returns a Result. `writable`: the folders the
     command may write (cwd, default the first of them, is one of them when isolated);
     `hidden`: folders it must not read (they look empty), `readable`: folders inside those
     it reads after all. `user` (a User; without isolation, as root): the command runs as
     that user under RLIMIT_NPROC, and every process of that user is killed when it ends
-    (`hidden`, `readable` and `writable` are then the file permissions' business). Raises
-    Stopped after stop_all()."""
+    (`hidden`, `readable` and `writable` are then the file permissions' business).
+    `pass_fds`: file descriptors the command inherits (the judge's pipes); they are the
+    command's: this process closes its copies as soon as the command started, or when run
+    returns or raises without starting it. Raises Stopped after stop_all()."""
+    fds = list(pass_fds)  # emptied once closed: each is closed exactly once
+    try:
+        return _run(cmd, limits, writable, cwd, isolate, keep, env, hidden, readable, user, fds)
+    finally:
+        _close_fds(fds)
+
+
+def _close_fds(fds):
+    """Closes the descriptors of the list `fds` and empties it."""
+    for fd in fds:
+        try:
+            os.close(fd)
+        except OSError:
+            pass
+    fds.clear()
+
+
+def _run(cmd, limits, writable, cwd, isolate, keep, env, hidden, readable, user, pass_fds):
     if _stop.is_set():
         raise Stopped()
     writable = [os.path.abspath(d) for d in writable]
@@ -522,14 +542,15 @@ def run(cmd, limits, writable=(), cwd=None, isolate=True, keep=1 << 20, env=None
             kill_user(user)  # nothing of that user runs beside the command
             try:
                 result = _run_limited(full, limits, cwd, isolate, keep, env, output_bytes, None,
-                                      _user_tasks(user.uid) + limits.processes, user)
+                                      _user_tasks(user.uid) + limits.processes, user, pass_fds)
             finally:
                 kill_user(user)
                 _reap_orphans(user)
     else:
         cgroup, nproc = _process_limit(limits)
         try:
-            result = _run_limited(full, limits, cwd, isolate, keep, env, output_bytes, cgroup, nproc)
+            result = _run_limited(full, limits, cwd, isolate, keep, env, output_bytes, cgroup, nproc,
+                                  pass_fds=pass_fds)
         finally:
             if cgroup:
                 _remove_cgroup(cgroup)
@@ -538,14 +559,19 @@ def run(cmd, limits, writable=(), cwd=None, isolate=True, keep=1 << 20, env=None
     return result
 
 
-def _run_limited(full, limits, cwd, isolate, keep, env, output_bytes, cgroup, nproc, user=None):
+def _run_limited(full, limits, cwd, isolate, keep, env, output_bytes, cgroup, nproc, user=None,
+                 pass_fds=None):
     started = time.monotonic()
     try:
         p = subprocess.Popen(full, cwd=cwd, stdin=subprocess.DEVNULL, stdout=subprocess.PIPE,
                              stderr=subprocess.PIPE, start_new_session=True, env=env,
-                             preexec_fn=_set_limits(limits, cgroup, nproc, user))
+                             preexec_fn=_set_limits(limits, cgroup, nproc, user),
+                             pass_fds=tuple(pass_fds or ()))
     except (OSError, subprocess.SubprocessError) as e:
         return Result("failed", f"failed: cannot start ({e})", 127, b"", str(e).encode(), 0.0)
+    finally:
+        if pass_fds:
+            _close_fds(pass_fds)  # the command's now (its peer sees the end when it ends)
     with _live_lock:
         _live.add(p)
     if _stop.is_set():  # stop_all ran between Popen and now

@@ -48,11 +48,12 @@ from dataclasses import dataclass
 
 from . import ROOT, sandbox
 from .box import Isolation, check_user_access, refuse_without_isolation
-from .build_and_run import configure, grade_step
+from . import judge
+from .build_and_run import GRADING_CACHE, build_and_run_visible, configure, run_hidden, step_rows
 from .errors import GradeError, OutOfTime
 from .exercises import BEGIN, exercises, step_sources
 from .grade_report import exercise_row, print_table, printable, results_by_exercise, say, write_json, write_junit
-from .grading_tree import assemble, hidden_copies, share_tree
+from .grading_tree import assemble, hidden_sources, share_tree
 from .strict_numbers import MAX_JOBS, MAX_MB, MAX_SECONDS, decimal, integer, step_list
 
 
@@ -75,6 +76,7 @@ class GradeOptions:
     no_isolation: bool = False  # without bubblewrap (the limits still hold)
     user: str = None  # without bubblewrap, as root: the unprivileged user student code runs as
     private: tuple = ()  # more paths that user must not read (the class grader's results)
+    judge: str = None  # the checkers' folder (None: WORK/judge); graders of one class share one
 
 
 @dataclass
@@ -123,7 +125,8 @@ def scrub_solution_outputs(work, log=None):
             path = os.path.join(d, n)
             rel = os.path.relpath(path, build)
             whole_step = r.returncode != 0 and rel.startswith(("steps/", "tests/")) and n.endswith(".o")
-            program = rel.startswith("tests/test_step") and os.sep not in rel[len("tests/"):]
+            program = ((rel.startswith("tests/test_step") and os.sep not in rel[len("tests/"):])
+                       or (n.startswith("judge_worker_") and os.sep not in rel))
             if rel in doomed or whole_step or n.endswith(".a") or program:
                 os.remove(path)
 
@@ -159,44 +162,81 @@ def grade(student, opts, out=None, log=None, deadline=None, partial=False):
     elif opts.no_isolation and os.geteuid() == 0:
         say("WARNING: as root without --user, student code runs as root", log)
     hidden = opts.hidden and os.path.abspath(opts.hidden)
-    unreadable = (ROOT, student_path, hidden, os.path.expanduser("~"), "/home", "/root")
+    judge_folder = os.path.abspath(opts.judge or os.path.join(work, "judge"))
+    unreadable = (ROOT, student_path, hidden, judge_folder, os.path.expanduser("~"), "/home", "/root")
     iso = Isolation(not opts.no_isolation,
                     build=sandbox.Limits(opts.build_timeout, opts.build_memory, opts.output, file_mb=2048),
                     test=sandbox.Limits(opts.timeout, opts.memory, opts.output), jobs=opts.jobs,
                     hidden=tuple(dict.fromkeys(p for p in unreadable if p)), deadline=deadline, log=log,
                     user=user)
     os.makedirs(work, exist_ok=True)
-    notes = assemble(student_path, hidden, work, steps)
+    # The checkers: the reference's tests and the hidden ones, built once for every tree
+    # graded here (or in a folder graders share), outside any sandbox: no student file in them.
+    hidden_by_step = hidden_sources(hidden, set(numbers), steps)
+    try:
+        checkers = judge.prepare(ROOT, judge_folder, hidden_by_step, steps, GRADING_CACHE, opts.jobs,
+                                 timeout=max(opts.build_timeout, 3600.0), say=lambda t: say(t, log))
+    except judge.JudgeError as e:
+        raise GradeError(f"grade: {e}") from None
+    workers, cmake = judge.worker_files(ROOT, steps)
+    notes = assemble(student_path, work, workers, cmake)
+    notes += [f"hidden tests for step {n}: {', '.join(name for name, _ in files)}"
+              for n, files in sorted(hidden_by_step.items())]
     if iso.drop:
         os.chmod(work, 0o755)
         share_tree(os.path.join(work, "src"))
         solutions = [os.path.join(ROOT, rel) for rel in solution_files()[:1]]
-        check_user_access(iso, work, solutions + [hidden] + hidden_copies(work) + list(opts.private))
+        check_user_access(iso, work, solutions + [hidden, judge_folder] + list(opts.private))
         notes.append(f"student code ran without isolation, as user {user.name}")
     elif not iso.isolate:
         notes.append("student code ran without isolation (--no-isolation)")
     configure(work, iso)
-    rows = []
-    # The test cases' folders: in WORK (the clone's build/ by default), not the shared /tmp,
-    # and removed when grading ends, however it ends.
-    with tempfile.TemporaryDirectory(prefix="scratch-", dir=work, ignore_cleanup_errors=True) as scratch:
+    graded = {}  # step: [build error, {exercise: [CaseOutcome]}, seconds]
+    done = set()  # the steps whose every case ran
+    # The cases' folders: the workers' in WORK (the clone's build/ by default), not the shared
+    # /tmp; the checkers' in the judge folder, out of every sandbox's sight; both removed when
+    # grading ends, however it ends.
+    with tempfile.TemporaryDirectory(prefix="scratch-", dir=work, ignore_cleanup_errors=True) as scratch, \
+            tempfile.TemporaryDirectory(prefix="cases-", dir=judge_folder, ignore_cleanup_errors=True) as private:
         if iso.drop:
             os.chmod(scratch, 0o711)  # the user reaches its case folders, lists nothing
-        for k, number in enumerate(steps):
-            items = [e for e in all_ex if f"{e.step:02d}" == number]
-            say(f"step {number}: building test_step{number}", log)
-            t0 = time.monotonic()
-            try:
-                step_rows = grade_step(work, number, items, iso, scratch, notes, log, t0)
-            except OutOfTime:
-                if not partial:
-                    raise
-                why = ("time limit", "not graded: the grading ran past its overall time limit")
-                for later in steps[k:]:
-                    rows += [exercise_row(e, later, why, [], 0.0) for e in all_ex if f"{e.step:02d}" == later]
-                say(f"out of time at step {number}: its exercises and the later ones are not graded", log)
-                break
-            rows += step_rows
+        runner = judge.Runner(
+            iso, scratch, private,
+            worker_readable=[os.path.join(work, "build"), os.path.join(work, "src", "data")],
+            checker_readable=[os.path.join(judge_folder, "build"), os.path.join(judge_folder, "src", "data")])
+        try:
+            # Every step's visible cases first, then the hidden ones: no worker of a visible
+            # case runs after one that saw a hidden case's input.
+            for number in steps:
+                items = [e for e in all_ex if f"{e.step:02d}" == number]
+                say(f"step {number}: building judge_worker_{number} (the student's code)", log)
+                t0 = time.monotonic()
+                error, outcomes = build_and_run_visible(work, number, items, iso, runner, checkers[number], log)
+                graded[number] = [error, outcomes, time.monotonic() - t0]
+                if not any(c.hidden for c in checkers[number].cases):
+                    done.add(number)
+            for number in steps:
+                if number in done:
+                    continue
+                error, outcomes, _ = graded[number]
+                t0 = time.monotonic()
+                run_hidden(work, number, runner, checkers[number], error, outcomes, log)
+                graded[number][2] += time.monotonic() - t0
+                done.add(number)
+        except OutOfTime:
+            if not partial:
+                raise
+            say(f"out of time: the exercises of step{'s' if len(steps) - len(done) > 1 else ''} "
+                f"{', '.join(n for n in steps if n not in done)} are not graded", log)
+    rows = []
+    why = ("time limit", "not graded: the grading ran past its overall time limit")
+    for number in steps:
+        items = [e for e in all_ex if f"{e.step:02d}" == number]
+        if number in done:
+            error, outcomes, seconds = graded[number]
+            rows += step_rows(number, items, checkers[number], error, outcomes, notes, seconds)
+        else:
+            rows += step_rows(number, items, checkers[number], why, {}, notes, 0.0)
     notes = [printable(n) for n in notes]
     if student_path == ROOT:
         scrub_solution_outputs(work, log)

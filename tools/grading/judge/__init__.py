@@ -17,17 +17,19 @@ reused for every student graded with the same reference and hidden tests. The ca
 are listed by the checker (a trusted program), each with the file it comes from: a case is
 hidden when its file is one of the hidden tests, whatever doctest form declares it.
 """
+import dataclasses
 import fcntl
 import os
 import re
 import shutil
 import subprocess
 import threading
+import time
 import xml.etree.ElementTree as ET
 from dataclasses import dataclass
 
 from .. import sandbox
-from ..exercises import SOURCE_SUFFIXES, exercises, step_dirs
+from ..exercises import case_results, exercises, step_dirs
 from . import stubs
 
 HERE = os.path.dirname(os.path.abspath(__file__))
@@ -309,10 +311,19 @@ def list_cases(binary):
                        capture_output=True, timeout=120, stdin=subprocess.DEVNULL,
                        env={"PATH": "/usr/bin:/bin"})
     try:
-        doc = ET.fromstring(r.stdout.decode(errors="replace"))
-    except ET.ParseError:
+        return listed_cases(r.stdout)
+    except JudgeError:
         raise JudgeError(f"judge: {binary} does not list its test cases "
                          f"({r.stderr.decode(errors='replace').strip()[-200:]})") from None
+
+
+def listed_cases(stdout):
+    """[(suite, name, file)] from doctest's --list-test-cases --reporters=xml output, or
+    JudgeError when it is no such list."""
+    try:
+        doc = ET.fromstring(stdout.decode(errors="replace"))
+    except ET.ParseError:
+        raise JudgeError("judge: no list of test cases") from None
     return [(c.get("testsuite", ""), c.get("name", ""), c.get("filename", ""))
             for c in doc.iter("TestCase")]
 
@@ -415,10 +426,9 @@ class Runner:
 
 def run_case(runner, checker, case, worker_binary, folder_name):
     """(status, reason, seconds) of one case: a fresh checker and a fresh worker."""
-    from ..grade import OutOfTime, clean_env, doctest_filter, read_result
-    from ..exercises import case_results
-    import dataclasses
-    import time
+    from ..box import clean_env
+    from ..build_and_run import doctest_filter, read_result
+    from ..errors import OutOfTime
 
     iso = runner.iso
     limits = iso.test

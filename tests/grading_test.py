@@ -22,6 +22,13 @@ usage: tests/grading_test.py SCENARIO WORK_DIR
                  exit 77, where bubblewrap cannot run)
   no-isolation   where bubblewrap cannot create namespaces (a fake bwrap that fails) the
                  grader refuses in one line, and grades with --no-isolation
+  judge-forged, judge-exit-list, judge-hidden (and each with -fallback: without bubblewrap,
+                 as root, the student's code as a user of its own; skipped, 77, when not root)
+                 the judge against hostile student code: a result forged before main and an
+                 exit 0 score nothing; an exit 0 inside an exercise fails it; a filtered list
+                 of cases changes nothing; hidden tests in every doctest form are hidden and
+                 counted, and spying code (and a header that breaks doctest's macros) learns
+                 nothing of them that reaches what a student sees
   each-solved    (by hand, not in ctest) each exercise solved alone scores exactly its points
 
 The steps are discovered, not named: grading scenarios use the first step with exercises
@@ -409,7 +416,7 @@ HOSTILE = {
     "read": ("failed", "cannot read", []),
     "network": ("failed", "connect: ", []),
     "output": ("output limit", "output limit", ["--output", "4"]),
-    "static": ("time limit", "time limit (the test program does not list its tests)",
+    "static": ("time limit", "time limit (the step's worker does not start)",
                ["--timeout", "3", "--build-timeout", "120"]),
     "compile": ("does not compile", "does not compile: memory limit", ["--build-memory", "1024"]),
     "compile-time": ("does not compile", "does not compile: time limit", ["--build-timeout", "10"]),
@@ -536,6 +543,409 @@ def scenario_each_solved(work):
                             for i in wrong)))
 
 
+# The judge: hostile student code against the checker and the worker ---------------------------
+# Each judge-* scenario runs under bubblewrap, and with -fallback appended without it, as
+# Gradescope's container runs it: as root, the student's code as an unprivileged user of its
+# own (created here, removed after; skipped, 77, when not root).
+
+FORGE = r"""
+#include <fcntl.h>
+#include <unistd.h>
+#include <cstdio>
+#include <cstring>
+#include <string>
+namespace {
+// Before main: a doctest result that says the case the command line names passed, written
+// wherever a result may be read (--out=, stdout, the working folder), then exit 0.
+struct ForgedResult {
+    ForgedResult() {
+        std::string args, out = "result.xml", name = "forged";
+        if (FILE* f = std::fopen("/proc/self/cmdline", "rb")) {
+            char buf[8192];
+            size_t n = std::fread(buf, 1, sizeof buf, f);
+            std::fclose(f);
+            for (size_t i = 0; i < n;) {
+                std::string a(buf + i);
+                i += a.size() + 1;
+                if (a.rfind("--out=", 0) == 0) out = a.substr(6);
+                if (a.rfind("--test-case=", 0) == 0) name = a.substr(12);
+            }
+        }
+        std::string xml = "<?xml version=\"1.0\"?><doctest><TestSuite name=\"exercise 1.1\"><TestCase name=\"" +
+                          name + "\"><OverallResultsAsserts successes=\"1\" failures=\"0\" test_case_success=\"true\"/>"
+                          "</TestCase></TestSuite><OverallResultsAsserts successes=\"1\" failures=\"0\"/>"
+                          "<OverallResultsTestCases successes=\"1\" failures=\"0\"/></doctest>\n";
+        for (const std::string& path : {out, std::string("result.xml"), std::string("/tmp/result.xml")})
+            if (FILE* f = std::fopen(path.c_str(), "w")) {
+                std::fputs(xml.c_str(), f);
+                std::fclose(f);
+            }
+        std::fputs(xml.c_str(), stdout);
+        std::fflush(stdout);
+        _exit(0);
+    }
+} forgedResult;
+}  // namespace
+"""
+
+# The case list filtered at the source: when asked for its cases, the program lists them
+# without exercise 1.6's (whose solution below is wrong), as the grader once trusted it to.
+FILTER_LIST = r"""
+#include <unistd.h>
+#include <cstdio>
+#include <string>
+namespace {
+struct FilteredList {
+    FilteredList() {
+        std::string args;
+        if (FILE* f = std::fopen("/proc/self/cmdline", "rb")) {
+            char buf[8192];
+            size_t n = std::fread(buf, 1, sizeof buf, f);
+            std::fclose(f);
+            args.assign(buf, n);
+        }
+        if (args.find("--list-test-cases") == std::string::npos) return;
+        std::fputs("<?xml version=\"1.0\"?><doctest><TestSuite><TestCase name=\"only this\" "
+                   "testsuite=\"exercise 1.1\"/></TestSuite></doctest>\n", stdout);
+        std::fflush(stdout);
+        _exit(0);
+    }
+} filteredList;
+}  // namespace
+"""
+
+SECRET = "SECRET-7c41"  # in the hidden tests' names and sources only
+SECRET_INPUT = "4242.4"  # the start of the hidden cases' distinctive input, 4242.42432f, as printed
+SECRET_VALUE = "8675.309"  # an expected value only the hidden tests hold
+
+
+def hidden_tests_in_every_form(folder):
+    """Hidden tests of step 01's exercises in the doctest forms a regex over the sources
+    missed: TEST_SUITE_BEGIN/END, TEST_CASE_FIXTURE, a test_suite decorator with SUBCASEs, and
+    a plain TEST_SUITE block; each calls its exercise with a distinctive input."""
+    os.makedirs(folder, exist_ok=True)
+    with open(os.path.join(folder, "step01_forms.cpp"), "w") as f:
+        f.write(f"""#include <doctest/doctest.h>
+#include <cmath>
+#include "01_triangle/triangle.hpp"
+using namespace boxes;
+namespace {{
+const float kSecretInput = 4242.42432f;
+volatile double secretExpected = {SECRET_VALUE};
+struct SecretFixture {{
+    Triangle tri{{{{0, 0, 0}}, {{kSecretInput, 0, 0}}, {{0, kSecretInput, 0}}}};
+}};
+}}  // namespace
+TEST_SUITE_BEGIN("exercise 1.1");
+TEST_CASE("{SECRET} begin-end form") {{
+    auto p = trianglePlane(Triangle{{{{0, 0, kSecretInput}}, {{1, 0, kSecretInput}}, {{0, 1, kSecretInput}}}});
+    REQUIRE(p.has_value());
+    CHECK(p->d == doctest::Approx(-kSecretInput));
+    CHECK(secretExpected > 1.0);
+}}
+TEST_SUITE_END();
+TEST_CASE_FIXTURE(SecretFixture, "{SECRET} fixture form" * doctest::test_suite("exercise 1.4")) {{
+    auto h = intersectMollerTrumbore(Ray({{1, 1, 1}}, {{0, 0, -1}}), tri);
+    REQUIRE(h.has_value());
+    CHECK(h->t == doctest::Approx(1.0));
+}}
+TEST_CASE("{SECRET} decorator form" * doctest::test_suite("exercise 1.6")) {{
+    SUBCASE("{SECRET} subcase") {{
+        Vec3 n = interpolateNormal(Vec3(1, 0, 0), Vec3(0, 1, 0), Vec3(0, 0, 1), 0.0f, 1.0f / kSecretInput);
+        CHECK(std::abs(glm::length(n) - 1.0f) < 1e-5f);
+    }}
+}}
+TEST_SUITE("exercise 1.5") {{
+    TEST_CASE("{SECRET} suite block form") {{
+        auto h = intersectWatertight(Ray({{1, 1, 1}}, {{0, 0, -1}}), Triangle{{{{0, 0, 0}}, {{kSecretInput, 0, 0}}, {{0, kSecretInput, 0}}}});
+        CHECK(h.has_value());
+    }}
+}}
+""")
+    return 4  # hidden cases
+
+
+def spy_code(paths):
+    """Student code that spies: every exercise call leaves its input where a later worker
+    might look, and looks for what other cases left or hold (files left in the shared
+    folders, other processes' command lines and environments, the judge's folder, the hidden
+    tests, the checkers); what it finds goes into an exception, which a case's failure shows."""
+    places = ", ".join(c_string(p) for p in paths)
+    return r"""
+#include <dirent.h>
+#include <unistd.h>
+#include <cstdio>
+#include <cstring>
+#include <stdexcept>
+#include <string>
+#include <vector>
+namespace boxes_spy {
+inline void grab(const std::string& path, std::string& found, int depth = 0) {
+    if (depth > 6 || found.size() > (8u << 20)) return;
+    if (DIR* d = opendir(path.c_str())) {
+        while (dirent* e = readdir(d))
+            if (std::strcmp(e->d_name, ".") && std::strcmp(e->d_name, ".."))
+                grab(path + "/" + e->d_name, found, depth + 1);
+        closedir(d);
+        return;
+    }
+    if (FILE* f = std::fopen(path.c_str(), "rb")) {
+        std::vector<char> buf(1 << 20);
+        size_t n = std::fread(buf.data(), 1, buf.size(), f);
+        std::fclose(f);
+        found.append(buf.data(), n);
+        found += "\n";
+    }
+}
+inline void look(const char* exercise, const std::string& input) {
+    // This case's input, left for a later worker.
+    for (const char* dir : {"/tmp", "/var/tmp", "/dev/shm", "."}) {
+        std::string path = std::string(dir) + "/boxes-spy-" + std::to_string(getpid());
+        if (FILE* f = std::fopen(path.c_str(), "a")) {
+            std::fprintf(f, "%s %s\n", exercise, input.c_str());
+            std::fclose(f);
+        }
+    }
+    std::string found;
+    for (const char* dir : {"/tmp", "/var/tmp", "/dev/shm", "."}) grab(dir, found, 5);
+    if (DIR* d = opendir("/proc")) {
+        while (dirent* e = readdir(d))
+            if (e->d_name[0] >= '0' && e->d_name[0] <= '9') {
+                grab(std::string("/proc/") + e->d_name + "/cmdline", found, 6);
+                grab(std::string("/proc/") + e->d_name + "/environ", found, 6);
+            }
+        closedir(d);
+    }
+    for (const char* place : {""" + places + r"""}) grab(place, found);
+    for (const char* needle : {"SECRET-7c41", "8675.309", "4242.4"}) {
+        size_t at = found.find(needle);
+        if (at != std::string::npos)
+            throw std::runtime_error(std::string("the spy learned: ") +
+                                     found.substr(at > 200 ? at - 200 : 0, 400));
+    }
+}
+template <typename... T>
+std::string text(const T&... values) {
+    std::string s;
+    auto add = [&](const auto& v) {
+        const unsigned char* p = reinterpret_cast<const unsigned char*>(&v);
+        for (size_t i = 0; i + 4 <= sizeof v; i += 4) {
+            float x;
+            std::memcpy(&x, p + i, 4);
+            char b[32];
+            std::snprintf(b, sizeof b, "%.9g ", double(x));
+            s += b;
+        }
+    };
+    (add(values), ...);
+    return s;
+}
+}  // namespace boxes_spy
+"""
+
+
+def spy_tree(dest, paths):
+    """The reference's step sources; every exercise of step 01 spies before its solution, and
+    a header breaks doctest's macros (the compile-log trick: were a hidden test compiled with
+    it, the compiler would quote the hidden test's lines into the log)."""
+    student_tree(dest)
+    ids = [e for e in exercises(ROOT) if e.step == 1]
+    by_file = {}
+    for e in ids:
+        by_file.setdefault(e.path, []).append(e)
+    for rel, items in by_file.items():
+        path = os.path.join(dest, rel)
+        with open(path, encoding="utf-8") as f:
+            lines = f.read().split("\n")
+        for e in sorted(items, key=lambda e: -e.begin):
+            args = ", ".join(e.parameters)
+            lines.insert(e.begin + 1, f'    boxes_spy::look("{e.id}", boxes_spy::text({args}));')
+        with open(path, "w", encoding="utf-8") as f:
+            f.write(spy_code(paths) + "\n".join(lines))
+    header = os.path.join(dest, "steps", "01_triangle", "triangle.hpp")
+    with open(header, encoding="utf-8") as f:
+        text = f.read()
+    with open(header, "w", encoding="utf-8") as f:
+        f.write(text + "\n// The compile-log trick: doctest's macros broken for whatever includes this.\n"
+                "#define TEST_CASE(...) static_assert(false, \"broken\");\n"
+                "#define TEST_SUITE(...) namespace broken\n#define CHECK(...) CHECK_is_broken\n"
+                "#define REQUIRE(...) REQUIRE_is_broken\n")
+
+
+def fallback_user(work):
+    """As root: a fresh unprivileged user for the fallback scenarios (removed at exit)."""
+    import atexit
+    import hashlib
+    name = "boxes-j" + hashlib.sha1(os.path.abspath(work).encode()).hexdigest()[:8]
+    subprocess.run(["userdel", name], capture_output=True)
+    subprocess.run(["useradd", "--system", "--no-create-home", "--home-dir", "/nonexistent",
+                    "--shell", "/usr/sbin/nologin", name], check=True, capture_output=True)
+    atexit.register(lambda: subprocess.run(["userdel", name], capture_output=True))
+    return name
+
+
+def judge_grade(student, work, flags, json_path, extra=()):
+    cmd = GRADE + [student, "--work", work, "--steps", "01", "--junit", os.path.join(work, "judge.xml"),
+                   "--json", json_path, "--timeout", "30"] + flags + list(extra)
+    if os.path.exists(json_path):
+        os.remove(json_path)
+    r = subprocess.run(cmd, capture_output=True, text=True, timeout=1800, cwd=ROOT)
+    print(r.stdout, r.stderr[-4000:])
+    results = {}
+    if os.path.exists(json_path):
+        with open(json_path) as f:
+            results = {x["exercise"]: x for x in json.load(f)["exercises"]}
+    return r, results
+
+
+def judge_mode(work, fallback):
+    """(grade.py's flags, work folder) for bubblewrap or the fallback, or None to skip."""
+    if fallback:
+        if os.geteuid() != 0:
+            print("SKIP: the fallback runs student code as a user of its own: creating it needs root")
+            return None
+        # The fallback's folders must let that user in: not under a 0700 home.
+        return ["--no-isolation", "--user", fallback_user(work)], work
+    problem = isolation_problem()
+    if problem:
+        print(f"SKIP: {problem}")
+        return None
+    return [], work
+
+
+def scenario_judge_forged(work, fallback):
+    """An untouched kit whose code forges a passing result before main and exits 0: every
+    exercise scores 0, and the grader says the worker ended before its first call."""
+    mode = judge_mode(work, fallback)
+    if mode is None:
+        return SKIPPED
+    flags, work = mode
+    ids = [e.id for e in exercises(ROOT) if e.step == 1]
+    with tempfile.TemporaryDirectory(dir=work) as student:
+        os.chmod(student, 0o755)
+        student_tree(student, keep=())
+        with open(os.path.join(student, "steps", "01_triangle", "triangle.cpp"), "a") as f:
+            f.write(FORGE)
+        r, results = judge_grade(student, work, flags, os.path.join(work, "judge-forged.json"))
+    check(r.returncode == 0, "forged: grade.py exits 0")
+    check(sorted(results) == sorted(ids), "forged: every exercise of step 01 is in the report")
+    for i in ids:
+        got = results.get(i, {})
+        check(got.get("points") == 0 and "before its first call" in got.get("reason", ""),
+              f"forged: exercise {i} scores 0: {got.get('status')!r} {got.get('reason', '')[:200]!r}")
+    check("Grade: 0 of" in r.stdout, "forged: zero points")
+
+
+def scenario_judge_exit_list(work, fallback):
+    """The reference, but exercise 1.5 exits 0 inside its function, exercise 1.6 is wrong and
+    the code filters the list of cases it is asked for: 1.5 and 1.6 score 0, each with its
+    reason, every other exercise passes, and 1.6 runs all its reference cases."""
+    mode = judge_mode(work, fallback)
+    if mode is None:
+        return SKIPPED
+    flags, work = mode
+    ids = [e.id for e in exercises(ROOT) if e.step == 1]
+    by_id = {e.id: e for e in exercises(ROOT)}
+    with tempfile.TemporaryDirectory(dir=work) as student:
+        os.chmod(student, 0o755)
+        hostile_tree(student, by_id["1.5"], ["std::exit(0);  // an early exit, with success"])
+        path = os.path.join(student, by_id["1.6"].path)
+        with open(path, encoding="utf-8") as f:
+            text = f.read()
+        wrong = text.replace("Vec3 n = (1.0f - u - v) * na + u * nb + v * nc;",
+                             "Vec3 n = (1.0f - u - v) * na + v * nb + u * nc;  // u and v swapped")
+        check(wrong != text, "exit-list: exercise 1.6's solution line is found and made wrong")
+        with open(path, "w", encoding="utf-8") as f:
+            f.write("#include <cstdlib>\n" + wrong + FILTER_LIST)
+        r, results = judge_grade(student, work, flags, os.path.join(work, "judge-exit.json"))
+    check(r.returncode == 0, "exit-list: grade.py exits 0")
+    got = results.get("1.5", {})
+    check(got.get("points") == 0 and "the worker ended while exercise 1.5 ran" in got.get("reason", "")
+          and "exit 0" in got.get("reason", ""),
+          f"exit-list: exercise 1.5 exits 0 in its call and scores 0: {got.get('reason', '')[:200]!r}")
+    got = results.get("1.6", {})
+    check(got.get("points") == 0 and got.get("status") == "failed" and "CHECK" in got.get("reason", ""),
+          f"exit-list: exercise 1.6 fails its checks: {got.get('reason', '')[:200]!r}")
+    others = [i for i in ids if i not in ("1.5", "1.6")]
+    check(all(results.get(i, {}).get("status") == "passed" for i in others),
+          "exit-list: every other exercise passes: " + ", ".join(f"{i} {results.get(i, {}).get('status')}" for i in others))
+    # Had the filtered list been the grader's, exercise 1.6 would have had no cases ("no
+    # tests"): its failed check shows its reference cases ran.
+
+
+def scenario_judge_hidden(work, fallback):
+    """Hidden tests in every doctest form against spying student code (and a header that
+    breaks doctest's macros): full points, the hidden cases recognised as hidden and counted,
+    and nothing of them (names, inputs, expected values) in what a student sees before
+    publication (Gradescope's visible tests and output), in the grading tree, the student's
+    build or its logs."""
+    mode = judge_mode(work, fallback)
+    if mode is None:
+        return SKIPPED
+    flags, work = mode
+    from tools.grading import gradescope
+    from tools.grading.grade import GradeOptions, grade_into
+    hidden = os.path.join(work, "judge-hidden-tests")
+    shutil.rmtree(hidden, ignore_errors=True)
+    count = hidden_tests_in_every_form(hidden)
+    os.chmod(hidden, 0o700)
+    ids = [e.id for e in exercises(ROOT) if e.step == 1]
+    judge_folder = os.path.join(work, "judge")
+    places = [hidden, judge_folder, os.path.join(judge_folder, "build", "tests", "judge_hidden_step01"),
+              os.path.join(judge_folder, "src", "tests", "hidden"), ROOT]
+    folder = os.path.join(work, "judge-hidden-report")
+    shutil.rmtree(folder, ignore_errors=True)
+    with tempfile.TemporaryDirectory(dir=work) as student:
+        os.chmod(student, 0o755)
+        spy_tree(student, places)
+        user = flags[flags.index("--user") + 1] if "--user" in flags else None
+        opts = GradeOptions(work=work, steps=["01"], hidden=hidden, timeout=30.0,
+                            no_isolation=bool(flags), user=user)
+        for run in (1, 2):  # the second run's workers may find what the first run's left
+            report = grade_into(folder, student, opts)
+            with open(os.path.join(folder, "grade.log"), errors="replace") as f:
+                print(f.read()[-3000:])
+            check(report.code == 0, f"hidden, run {run}: graded")
+            results = {x["exercise"]: x for x in report.results}
+            check(all(results.get(i, {}).get("passed") for i in ids),
+                  f"hidden, run {run}: full points (the spy found nothing): " +
+                  "; ".join(f"{i}: {results.get(i, {}).get('reason', '')[:300]}" for i in ids
+                            if not results.get(i, {}).get("passed")))
+            check(sum(x.get("hidden", 0) for x in report.results) == count,
+                  f"hidden, run {run}: the {count} hidden cases in four doctest forms are recognised as hidden "
+                  f"({sum(x.get('hidden', 0) for x in report.results)})")
+            doc = gradescope.results_json(report.results, {"steps": ["01"], "hidden_visibility": "after_published"},
+                                          report.notes, report.seconds)
+            shown = doc["output"] + "".join(t["name"] + t["output"] for t in doc["tests"] if t["visibility"] == "visible")
+            for needle in (SECRET, SECRET_INPUT, SECRET_VALUE, "step01_forms"):
+                check(needle not in shown, f"hidden, run {run}: {needle!r} is not in what the student sees")
+            held = {t["number"] for t in doc["tests"] if t["visibility"] != "visible"}
+            check(held == {"1.1", "1.4", "1.5", "1.6"}, f"hidden, run {run}: the exercises with hidden cases are held back: {sorted(held)}")
+            visible_total = doc["output"].split(" points", 1)[0]
+            check(visible_total == f"{points(['1.2', '1.3'])} of {points(['1.2', '1.3'])}",
+                  f"hidden, run {run}: the visible total counts only the exercises without hidden cases: {visible_total!r}")
+    # Nothing a sandbox of the student's could read holds the hidden tests.
+    leaks = []
+    for base in (os.path.join(work, "src"), os.path.join(work, "build")):
+        for d, _, names in os.walk(base):
+            for n in names:
+                p = os.path.join(d, n)
+                if os.path.islink(p) or not os.path.isfile(p):
+                    continue
+                with open(p, "rb") as f:
+                    if SECRET.encode() in f.read():
+                        leaks.append(p)
+    for n in os.listdir(work):
+        p = os.path.join(work, n)
+        if n.endswith(".log") and os.path.isfile(p):
+            with open(p, "rb") as f:
+                if SECRET.encode() in f.read():
+                    leaks.append(p)
+    check(not leaks, f"hidden: no file of the grading tree, the student's build or its logs holds a hidden test: {leaks[:5]}")
+    mode_ = os.stat(judge_folder).st_mode & 0o777
+    check(mode_ == 0o700, f"hidden: the judge's folder is the grader's only ({oct(mode_)})")
+
+
 def main():
     if len(sys.argv) != 3:
         print(__doc__, file=sys.stderr)
@@ -548,6 +958,10 @@ def main():
                  "each-solved": scenario_each_solved}
     for kind in HOSTILE:
         scenarios[f"hostile-{kind}"] = lambda w, kind=kind: scenario_hostile(w, kind)
+    for name, fn in (("judge-forged", scenario_judge_forged), ("judge-exit-list", scenario_judge_exit_list),
+                     ("judge-hidden", scenario_judge_hidden)):
+        scenarios[name] = lambda w, fn=fn: fn(w, False)
+        scenarios[name + "-fallback"] = lambda w, fn=fn: fn(w, True)
     if scenario not in scenarios:
         print(__doc__, file=sys.stderr)
         return 2

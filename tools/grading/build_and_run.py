@@ -146,6 +146,10 @@ def build_and_run_visible(work, number, items, iso, runner, checker, log):
     error = build_step(work, number, iso)
     outcomes = {e.id: [] for e in items}
     if not error:
+        error = judge.probe(runner, os.path.join(work, "build", f"judge_worker_{number}"), f"{number}-probe")
+        if error:
+            say(printable(f"step {number}: {error[1]}"), log)
+    if not error:
         run_cases(work, number, [c for c in checker.cases if not c.hidden], runner, checker, outcomes, log)
     return error, outcomes
 

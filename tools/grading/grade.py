@@ -200,10 +200,9 @@ def grade(student, opts, out=None, log=None, deadline=None, partial=False):
             tempfile.TemporaryDirectory(prefix="cases-", dir=judge_folder, ignore_cleanup_errors=True) as private:
         if iso.drop:
             os.chmod(scratch, 0o711)  # the user reaches its case folders, lists nothing
-        runner = judge.Runner(
-            iso, scratch, private,
-            worker_readable=[os.path.join(work, "build"), os.path.join(work, "src", "data")],
-            checker_readable=[os.path.join(judge_folder, "build"), os.path.join(judge_folder, "src", "data")])
+        runner = judge.Runner(iso, scratch, private,
+                              worker_readable=[os.path.join(work, "build"), os.path.join(work, "src", "data")],
+                              judge_folder=judge_folder)
         try:
             # Every step's visible cases first, then the hidden ones: no worker of a visible
             # case runs after one that saw a hidden case's input.

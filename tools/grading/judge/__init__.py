@@ -21,7 +21,9 @@ import dataclasses
 import fcntl
 import os
 import re
+import select
 import shutil
+import struct
 import subprocess
 import threading
 import time
@@ -35,9 +37,10 @@ from . import stubs
 HERE = os.path.dirname(os.path.abspath(__file__))
 HIDDEN_DIR = "tests/hidden"  # where the checker's tree keeps the hidden tests
 # The checker is trusted code that reads the worker's answers: the standard library's bounds
-# checks (vector, span, array) stop it at the first index a wrong answer would take out of
-# range, instead of reading the checker's memory.
-CHECKER_FLAGS = "-O1 -DNDEBUG -D_GLIBCXX_ASSERTIONS"
+# checks (vector, span, array), fortified string functions and stack canaries stop it at the
+# first index a wrong answer would take out of range, instead of reading or writing the
+# checker's memory.
+CHECKER_FLAGS = "-O1 -DNDEBUG -D_GLIBCXX_ASSERTIONS -D_FORTIFY_SOURCE=2 -fstack-protector-strong"
 
 
 class JudgeError(Exception):
@@ -135,6 +138,9 @@ def checker_files(root, hidden_by_step):
         if rel in by_file:
             with open(path, encoding="utf-8") as f:
                 files[rel] = stubs.checker_text(f.read(), by_file[rel]).encode()
+        elif rel == "tests/test_main.cpp":
+            with open(path, encoding="utf-8") as f:
+                files[rel] = _checker_main(f.read()).encode()
         else:
             with open(path, "rb") as f:
                 files[rel] = f.read()
@@ -162,6 +168,18 @@ def checker_files(root, hidden_by_step):
             "endif()")
     files["tests/CMakeLists.txt"] += ("\n".join(extra) + "\n").encode()
     return files
+
+
+def _checker_main(text):
+    """The checkers' main: doctest takes the case to run from the environment too
+    (judge/checker_main.hpp)."""
+    context = "doctest::Context context(argc, argv);"
+    if context not in text or "#include <doctest/doctest.h>" not in text:
+        raise JudgeError("judge: tests/test_main.cpp has no doctest::Context context(argc, argv) "
+                         "to give the case's filters to")
+    text = text.replace("#include <doctest/doctest.h>",
+                        '#include <doctest/doctest.h>\n#include "judge/checker_main.hpp"', 1)
+    return text.replace(context, context + "\n    ::boxes::judge::applyCaseFilters(context);", 1)
 
 
 def worker_files(root, steps):
@@ -246,6 +264,19 @@ def _sync(dest, files):
         os.umask(old_umask)
 
 
+def _configured(build, entries):
+    """Whether the build folder is configured with these CMake cache entries."""
+    try:
+        with open(os.path.join(build, "CMakeCache.txt"), encoding="utf-8", errors="replace") as f:
+            cache = dict(line.split("=", 1) for line in f.read().splitlines()
+                         if "=" in line and not line.startswith(("//", "#")))
+    except OSError:
+        return False
+    values = {k.split(":")[0]: v for k, v in cache.items()}
+    return (os.path.exists(os.path.join(build, "build.ninja"))
+            and all(values.get(k) == v for k, v in entries.items()))
+
+
 def _run_logged(cmd, log_path, timeout):
     """A trusted command (the checker's configure and build): its output appended to a
     private log; (ok, last lines)."""
@@ -279,7 +310,7 @@ def prepare(root, folder, hidden_by_step, steps, cache, jobs=2, timeout=3600, sa
         launcher = shutil.which("ccache") if os.environ.get("BOXES_GRADE_CCACHE", "1") != "0" else None
         if launcher:
             entries["CMAKE_CXX_COMPILER_LAUNCHER"] = launcher
-        if not os.path.exists(os.path.join(build, "build.ninja")):
+        if not _configured(build, entries):
             say("judge: configuring the checkers (once; later grades reuse them)")
             if not _run_logged(["cmake", "-S", src, "-B", build, "-G", "Ninja"] +
                                [f"-D{k}={v}" for k, v in entries.items()], log, timeout):
@@ -421,7 +452,7 @@ class Runner:
     scratch: str  # the workers' case folders (the grading run's scratch)
     private: str  # the checkers' case folders: in the judge folder, 0700
     worker_readable: list  # what a worker reads: its build, the data
-    checker_readable: list  # what a checker reads: the checkers' build, their data
+    judge_folder: str  # the checkers' folder: no worker sees it
 
 
 def run_case(runner, checker, case, worker_binary, folder_name):
@@ -448,20 +479,26 @@ def run_case(runner, checker, case, worker_binary, folder_name):
         os.chown(wfolder, iso.user.uid, iso.user.gid)
     result = os.path.join(cfolder, "result.xml")
     binary = checker.hidden if case.hidden else checker.visible
-    cmd = [binary, "--source-file=" + doctest_filter(case.file),
-           "--test-suite=" + doctest_filter(case.suite), "--test-case=" + doctest_filter(case.name),
-           "--reporters=xml", "--no-version", f"--out={result}"]
+    cmd = [binary, "--reporters=xml", "--no-version", f"--out={result}"]
+    # The case by its file, suite and name, in the environment (checker_main.hpp): only the
+    # grader's user can read it, where every user could read a command line.
+    case_env = {"BOXES_JUDGE_FILE": doctest_filter(case.file), "BOXES_JUDGE_SUITE": doctest_filter(case.suite),
+                "BOXES_JUDGE_CASE": doctest_filter(case.name)}
     started = time.monotonic()
 
+    # The checker is the grader's own code: it runs as the grader, under the test limits but
+    # outside bubblewrap (a second sandbox per case would double its start-up cost). What
+    # the worker sends it is read with bounds checks (judge/wire.hpp, codec.hpp) and it is
+    # built with the standard library's and the compiler's checks (CHECKER_FLAGS).
     def checker_run(fds, text):
-        return sandbox.run(cmd, checker_limits, writable=[cfolder], isolate=iso.isolate,
-                           env=dict(clean_env(cfolder), BOXES_JUDGE_FDS=text), keep=1 << 16,
-                           hidden=iso.hidden, readable=runner.checker_readable, pass_fds=fds)
+        return sandbox.run(cmd, checker_limits, writable=[cfolder], cwd=cfolder, isolate=False,
+                           env=dict(clean_env(cfolder), BOXES_JUDGE_FDS=text, **case_env),
+                           keep=1 << 16, pass_fds=fds)
 
     def worker_run(fds, text):
         return sandbox.run([worker_binary], limits, writable=[wfolder], isolate=iso.isolate,
                            env=dict(clean_env(wfolder), BOXES_JUDGE_FDS=text), keep=1 << 16,
-                           hidden=tuple(iso.hidden) + (checker.folder,),
+                           hidden=tuple(iso.hidden) + (runner.judge_folder,),
                            readable=runner.worker_readable, user=iso.user if iso.drop else None,
                            pass_fds=fds)
 
@@ -476,3 +513,83 @@ def run_case(runner, checker, case, worker_binary, folder_name):
         raise OutOfTime()
     status, reason = verdict(c, w, found)
     return status, reason, time.monotonic() - started
+
+
+def _frame(kind, payload):
+    return struct.pack("<IB3x", len(payload), kind) + payload
+
+
+def _text(s):
+    return struct.pack("<Q", len(s)) + s
+
+
+def ping(fds, seconds):
+    """Calls the worker's built-in "judge.ping" on the pipes fds (read, write) and waits up
+    to `seconds` for its answer; True when it answered. Closes fds."""
+    read_fd, write_fd = fds
+    try:
+        try:
+            os.write(write_fd, _frame(1, _text(b"judge.ping") + _text(b"")))
+        except OSError:
+            return False
+        deadline = time.monotonic() + seconds
+        got = b""
+        while len(got) < 8:
+            left = deadline - time.monotonic()
+            if left <= 0 or not select.select([read_fd], [], [], left)[0]:
+                return False
+            chunk = os.read(read_fd, 8 - len(got))
+            if not chunk:
+                return False
+            got += chunk
+        size, kind = struct.unpack("<IB3x", got)
+        return kind == 2 and size == 0
+    finally:
+        for fd in fds:
+            os.close(fd)
+
+
+def probe(runner, worker_binary, folder_name):
+    """'' when the step's worker starts and answers a call, else why not (a global object's
+    constructor that never ends, a crash or an exit before main): then no case of the step
+    can pass, and the grader does not wait for each case to find out."""
+    from ..box import clean_env
+    from ..errors import OutOfTime
+
+    iso = runner.iso
+    limits = iso.test
+    if iso.deadline is not None:
+        left = iso.deadline - time.monotonic()
+        if left <= 0:
+            raise OutOfTime()
+        limits = dataclasses.replace(limits, seconds=min(limits.seconds, left))
+    wfolder = os.path.join(runner.scratch, folder_name)
+    os.makedirs(wfolder)
+    if iso.drop:
+        os.chown(wfolder, iso.user.uid, iso.user.gid)
+    answered = {}
+
+    def asker(fds, text):
+        answered["ok"] = ping(fds, limits.seconds)
+        return None
+
+    def worker_run(fds, text):
+        return sandbox.run([worker_binary], limits, writable=[wfolder], isolate=iso.isolate,
+                           env=dict(clean_env(wfolder), BOXES_JUDGE_FDS=text), keep=1 << 16,
+                           hidden=tuple(iso.hidden) + (runner.judge_folder,),
+                           readable=runner.worker_readable, user=iso.user if iso.drop else None,
+                           pass_fds=fds)
+
+    try:
+        _, w = run_pair(asker, worker_run)
+    finally:
+        shutil.rmtree(wfolder, ignore_errors=True)
+    if iso.deadline is not None and time.monotonic() >= iso.deadline:
+        raise OutOfTime()
+    if answered.get("ok"):
+        return ""
+    if w is None or w.ok or w.status == "failed":
+        how = "exit 0" if w is None or w.ok else w.reason[len("failed: "):]
+        return ("failed", f"failed: the step's worker ended ({how}) before its first call "
+                          "(the student's code runs before main?)")
+    return (w.status, f"{w.reason} (the step's worker does not start)")

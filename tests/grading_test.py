@@ -614,9 +614,11 @@ struct FilteredList {
 }  // namespace
 """
 
-SECRET = "SECRET-7c41"  # in the hidden tests' names and sources only
-SECRET_INPUT = "4242.4"  # the start of the hidden cases' distinctive input, 4242.42432f, as printed
-SECRET_VALUE = "8675.309"  # an expected value only the hidden tests hold
+# What only the hidden tests hold, put together here so that this file (which the grading
+# tree holds) and the spy's code never hold them whole.
+SECRET = "SECRET-" + "7c41"  # in the hidden tests' names
+SECRET_INPUT = "4242." + "4"  # the start of the hidden cases' distinctive input as printed
+SECRET_VALUE = "8675." + "309"  # an expected value only the hidden tests hold
 
 
 def hidden_tests_in_every_form(folder):
@@ -630,7 +632,7 @@ def hidden_tests_in_every_form(folder):
 #include "01_triangle/triangle.hpp"
 using namespace boxes;
 namespace {{
-const float kSecretInput = 4242.42432f;
+const float kSecretInput = 4242.0f + 0.42432f;
 volatile double secretExpected = {SECRET_VALUE};
 struct SecretFixture {{
     Triangle tri{{{{0, 0, 0}}, {{kSecretInput, 0, 0}}, {{0, kSecretInput, 0}}}};
@@ -682,6 +684,8 @@ def spy_code(paths):
 namespace boxes_spy {
 inline void grab(const std::string& path, std::string& found, int depth = 0) {
     if (depth > 6 || found.size() > (8u << 20)) return;
+    const std::string mine = "/boxes-spy-" + std::to_string(getpid());  // this worker's own
+    if (path.size() >= mine.size() && path.compare(path.size() - mine.size(), mine.size(), mine) == 0) return;
     if (DIR* d = opendir(path.c_str())) {
         while (dirent* e = readdir(d))
             if (std::strcmp(e->d_name, ".") && std::strcmp(e->d_name, ".."))
@@ -698,14 +702,9 @@ inline void grab(const std::string& path, std::string& found, int depth = 0) {
     }
 }
 inline void look(const char* exercise, const std::string& input) {
-    // This case's input, left for a later worker.
-    for (const char* dir : {"/tmp", "/var/tmp", "/dev/shm", "."}) {
-        std::string path = std::string(dir) + "/boxes-spy-" + std::to_string(getpid());
-        if (FILE* f = std::fopen(path.c_str(), "a")) {
-            std::fprintf(f, "%s %s\n", exercise, input.c_str());
-            std::fclose(f);
-        }
-    }
+    static bool looked = false;  // once per worker (one case): the search is slow
+    if (looked) return;
+    looked = true;
     std::string found;
     for (const char* dir : {"/tmp", "/var/tmp", "/dev/shm", "."}) grab(dir, found, 5);
     if (DIR* d = opendir("/proc")) {
@@ -717,11 +716,21 @@ inline void look(const char* exercise, const std::string& input) {
         closedir(d);
     }
     for (const char* place : {""" + places + r"""}) grab(place, found);
-    for (const char* needle : {"SECRET-7c41", "8675.309", "4242.4"}) {
+    const std::string prefixes[] = {"SECRET-", "8675.", "4242."}, suffixes[] = {"7c41", "309", "4"};
+    for (int k = 0; k < 3; ++k) {
+        std::string needle = prefixes[k] + suffixes[k];  // never whole in this binary
         size_t at = found.find(needle);
         if (at != std::string::npos)
             throw std::runtime_error(std::string("the spy learned: ") +
                                      found.substr(at > 200 ? at - 200 : 0, 400));
+    }
+    // This case's input, left for a later worker.
+    for (const char* dir : {"/tmp", "/var/tmp", "/dev/shm", "."}) {
+        std::string path = std::string(dir) + "/boxes-spy-" + std::to_string(getpid());
+        if (FILE* f = std::fopen(path.c_str(), "a")) {
+            std::fprintf(f, "%s %s\n", exercise, input.c_str());
+            std::fclose(f);
+        }
     }
 }
 template <typename... T>
@@ -784,12 +793,13 @@ def fallback_user(work):
     return name
 
 
-def judge_grade(student, work, flags, json_path, extra=()):
-    cmd = GRADE + [student, "--work", work, "--steps", "01", "--junit", os.path.join(work, "judge.xml"),
-                   "--json", json_path, "--timeout", "30"] + flags + list(extra)
+def judge_grade(mode, student, json_path):
+    """grade.py on the student's tree, step 01, in the scenario's mode: (result, {exercise: row})."""
+    cmd = [sys.executable, "-m", "tools.grading.grade", student, "--work", mode["work"], "--steps", "01",
+           "--junit", os.path.join(mode["work"], "judge.xml"), "--json", json_path, "--timeout", "120"] + mode["flags"]
     if os.path.exists(json_path):
         os.remove(json_path)
-    r = subprocess.run(cmd, capture_output=True, text=True, timeout=1800, cwd=ROOT)
+    r = subprocess.run(cmd, capture_output=True, text=True, timeout=1800, cwd=mode["root"])
     print(r.stdout, r.stderr[-4000:])
     results = {}
     if os.path.exists(json_path):
@@ -798,19 +808,39 @@ def judge_grade(student, work, flags, json_path, extra=()):
     return r, results
 
 
+def reference_copy(dest):
+    """A copy of this tree's files (the grader, the solutions, the tests) in a folder only
+    root may enter: the fallback's user must not read the reference (grade.py checks)."""
+    from tools.grading.kit import tracked_files
+    os.makedirs(dest, exist_ok=True)
+    os.chmod(dest, 0o700)
+    tree = os.path.join(dest, "tree")
+    for rel in tracked_files(ROOT):
+        target = os.path.join(tree, rel)
+        os.makedirs(os.path.dirname(target), exist_ok=True)
+        shutil.copy2(os.path.join(ROOT, rel), target)
+    return tree
+
+
 def judge_mode(work, fallback):
-    """(grade.py's flags, work folder) for bubblewrap or the fallback, or None to skip."""
+    """How a judge scenario grades: {root: the tree whose grader runs, work: its grading
+    folder, flags: grade.py's}, or None to skip. The fallback is Gradescope's container: as
+    root, no bubblewrap, the student's code as an unprivileged user of its own (created here)
+    that cannot read the reference."""
     if fallback:
         if os.geteuid() != 0:
             print("SKIP: the fallback runs student code as a user of its own: creating it needs root")
             return None
-        # The fallback's folders must let that user in: not under a 0700 home.
-        return ["--no-isolation", "--user", fallback_user(work)], work
+        base = os.path.join(work, "fallback")
+        os.makedirs(base, exist_ok=True)
+        os.chmod(base, 0o755)
+        return {"root": reference_copy(os.path.join(base, "reference")), "work": os.path.join(base, "grade"),
+                "flags": ["--no-isolation", "--user", fallback_user(work)], "user": True}
     problem = isolation_problem()
     if problem:
         print(f"SKIP: {problem}")
         return None
-    return [], work
+    return {"root": ROOT, "work": work, "flags": [], "user": False}
 
 
 def scenario_judge_forged(work, fallback):
@@ -819,14 +849,12 @@ def scenario_judge_forged(work, fallback):
     mode = judge_mode(work, fallback)
     if mode is None:
         return SKIPPED
-    flags, work = mode
     ids = [e.id for e in exercises(ROOT) if e.step == 1]
     with tempfile.TemporaryDirectory(dir=work) as student:
-        os.chmod(student, 0o755)
         student_tree(student, keep=())
         with open(os.path.join(student, "steps", "01_triangle", "triangle.cpp"), "a") as f:
             f.write(FORGE)
-        r, results = judge_grade(student, work, flags, os.path.join(work, "judge-forged.json"))
+        r, results = judge_grade(mode, student, os.path.join(work, "judge-forged.json"))
     check(r.returncode == 0, "forged: grade.py exits 0")
     check(sorted(results) == sorted(ids), "forged: every exercise of step 01 is in the report")
     for i in ids:
@@ -843,11 +871,9 @@ def scenario_judge_exit_list(work, fallback):
     mode = judge_mode(work, fallback)
     if mode is None:
         return SKIPPED
-    flags, work = mode
     ids = [e.id for e in exercises(ROOT) if e.step == 1]
     by_id = {e.id: e for e in exercises(ROOT)}
     with tempfile.TemporaryDirectory(dir=work) as student:
-        os.chmod(student, 0o755)
         hostile_tree(student, by_id["1.5"], ["std::exit(0);  // an early exit, with success"])
         path = os.path.join(student, by_id["1.6"].path)
         with open(path, encoding="utf-8") as f:
@@ -857,7 +883,7 @@ def scenario_judge_exit_list(work, fallback):
         check(wrong != text, "exit-list: exercise 1.6's solution line is found and made wrong")
         with open(path, "w", encoding="utf-8") as f:
             f.write("#include <cstdlib>\n" + wrong + FILTER_LIST)
-        r, results = judge_grade(student, work, flags, os.path.join(work, "judge-exit.json"))
+        r, results = judge_grade(mode, student, os.path.join(work, "judge-exit.json"))
     check(r.returncode == 0, "exit-list: grade.py exits 0")
     got = results.get("1.5", {})
     check(got.get("points") == 0 and "the worker ended while exercise 1.5 ran" in got.get("reason", "")
@@ -873,60 +899,83 @@ def scenario_judge_exit_list(work, fallback):
     # tests"): its failed check shows its reference cases ran.
 
 
+# Grades in-process as Gradescope's run does (grade_into) and writes what Gradescope would
+# show (results_json) with the report's results and notes.
+GRADESCOPE_DRIVER = """import json, sys
+from tools.grading import gradescope
+from tools.grading.grade import GradeOptions, grade_into
+work, student, hidden, folder, user, out = sys.argv[1:]
+opts = GradeOptions(work=work, steps=["01"], hidden=hidden, timeout=120.0, no_isolation=bool(user),
+                    user=user or None)
+report = grade_into(folder, student, opts)
+doc = gradescope.results_json(report.results, {"steps": ["01"], "hidden_visibility": "after_published"},
+                              report.notes, report.seconds) if report.code == 0 else {}
+with open(out, "w") as f:
+    json.dump({"code": report.code, "results": report.results, "gradescope": doc}, f)
+"""
+
+
 def scenario_judge_hidden(work, fallback):
     """Hidden tests in every doctest form against spying student code (and a header that
     breaks doctest's macros): full points, the hidden cases recognised as hidden and counted,
     and nothing of them (names, inputs, expected values) in what a student sees before
-    publication (Gradescope's visible tests and output), in the grading tree, the student's
-    build or its logs."""
+    publication (Gradescope's visible tests and output), nor in the grading tree, the
+    student's build or its logs. Graded twice: the second run's workers look for what the
+    first run's left behind."""
     mode = judge_mode(work, fallback)
     if mode is None:
         return SKIPPED
-    flags, work = mode
-    from tools.grading import gradescope
-    from tools.grading.grade import GradeOptions, grade_into
+    grading = mode["work"]
     hidden = os.path.join(work, "judge-hidden-tests")
     shutil.rmtree(hidden, ignore_errors=True)
     count = hidden_tests_in_every_form(hidden)
     os.chmod(hidden, 0o700)
     ids = [e.id for e in exercises(ROOT) if e.step == 1]
-    judge_folder = os.path.join(work, "judge")
+    judge_folder = os.path.join(grading, "judge")
+    # Where the spy looks besides /tmp, /proc and its own folder: the hidden tests, the judge's
+    # folder, the hidden checker, the reference the grader runs (in the fallback a copy only
+    # root may enter: this clone itself is the developer's, readable to all).
     places = [hidden, judge_folder, os.path.join(judge_folder, "build", "tests", "judge_hidden_step01"),
-              os.path.join(judge_folder, "src", "tests", "hidden"), ROOT]
+              os.path.join(judge_folder, "src", "tests", "hidden"), mode["root"]]
     folder = os.path.join(work, "judge-hidden-report")
-    shutil.rmtree(folder, ignore_errors=True)
+    out = os.path.join(work, "judge-hidden.json")
+    user = mode["flags"][-1] if mode["user"] else ""
     with tempfile.TemporaryDirectory(dir=work) as student:
-        os.chmod(student, 0o755)
         spy_tree(student, places)
-        user = flags[flags.index("--user") + 1] if "--user" in flags else None
-        opts = GradeOptions(work=work, steps=["01"], hidden=hidden, timeout=30.0,
-                            no_isolation=bool(flags), user=user)
-        for run in (1, 2):  # the second run's workers may find what the first run's left
-            report = grade_into(folder, student, opts)
-            with open(os.path.join(folder, "grade.log"), errors="replace") as f:
-                print(f.read()[-3000:])
-            check(report.code == 0, f"hidden, run {run}: graded")
-            results = {x["exercise"]: x for x in report.results}
+        for run in (1, 2):
+            shutil.rmtree(folder, ignore_errors=True)
+            r = subprocess.run([sys.executable, "-c", GRADESCOPE_DRIVER, grading, student, hidden, folder, user, out],
+                               capture_output=True, text=True, timeout=3600, cwd=mode["root"])
+            print(r.stdout[-2000:], r.stderr[-2000:])
+            if os.path.exists(os.path.join(folder, "grade.log")):
+                with open(os.path.join(folder, "grade.log"), errors="replace") as f:
+                    print(f.read()[-3000:])
+            with open(out) as f:
+                got = json.load(f)
+            check(r.returncode == 0 and got["code"] == 0, f"hidden, run {run}: graded")
+            results = {x["exercise"]: x for x in got["results"]}
             check(all(results.get(i, {}).get("passed") for i in ids),
                   f"hidden, run {run}: full points (the spy found nothing): " +
                   "; ".join(f"{i}: {results.get(i, {}).get('reason', '')[:300]}" for i in ids
                             if not results.get(i, {}).get("passed")))
-            check(sum(x.get("hidden", 0) for x in report.results) == count,
-                  f"hidden, run {run}: the {count} hidden cases in four doctest forms are recognised as hidden "
-                  f"({sum(x.get('hidden', 0) for x in report.results)})")
-            doc = gradescope.results_json(report.results, {"steps": ["01"], "hidden_visibility": "after_published"},
-                                          report.notes, report.seconds)
-            shown = doc["output"] + "".join(t["name"] + t["output"] for t in doc["tests"] if t["visibility"] == "visible")
+            found = sum(x.get("hidden", 0) for x in got["results"])
+            check(found == count, f"hidden, run {run}: the {count} hidden cases in four doctest forms "
+                                  f"are recognised as hidden ({found})")
+            doc = got["gradescope"]
+            shown = doc.get("output", "") + "".join(t["name"] + t["output"] for t in doc.get("tests", [])
+                                                    if t["visibility"] == "visible")
             for needle in (SECRET, SECRET_INPUT, SECRET_VALUE, "step01_forms"):
                 check(needle not in shown, f"hidden, run {run}: {needle!r} is not in what the student sees")
-            held = {t["number"] for t in doc["tests"] if t["visibility"] != "visible"}
-            check(held == {"1.1", "1.4", "1.5", "1.6"}, f"hidden, run {run}: the exercises with hidden cases are held back: {sorted(held)}")
-            visible_total = doc["output"].split(" points", 1)[0]
+            held = {t["number"] for t in doc.get("tests", []) if t["visibility"] != "visible"}
+            check(held == {"1.1", "1.4", "1.5", "1.6"},
+                  f"hidden, run {run}: the exercises with hidden cases are held back: {sorted(held)}")
+            visible_total = doc.get("output", "").split(" points", 1)[0]
             check(visible_total == f"{points(['1.2', '1.3'])} of {points(['1.2', '1.3'])}",
-                  f"hidden, run {run}: the visible total counts only the exercises without hidden cases: {visible_total!r}")
+                  f"hidden, run {run}: the visible total counts only the exercises without hidden cases: "
+                  f"{visible_total!r}")
     # Nothing a sandbox of the student's could read holds the hidden tests.
     leaks = []
-    for base in (os.path.join(work, "src"), os.path.join(work, "build")):
+    for base in (os.path.join(grading, "src"), os.path.join(grading, "build")):
         for d, _, names in os.walk(base):
             for n in names:
                 p = os.path.join(d, n)
@@ -935,15 +984,16 @@ def scenario_judge_hidden(work, fallback):
                 with open(p, "rb") as f:
                     if SECRET.encode() in f.read():
                         leaks.append(p)
-    for n in os.listdir(work):
-        p = os.path.join(work, n)
+    for n in os.listdir(grading):
+        p = os.path.join(grading, n)
         if n.endswith(".log") and os.path.isfile(p):
             with open(p, "rb") as f:
                 if SECRET.encode() in f.read():
                     leaks.append(p)
-    check(not leaks, f"hidden: no file of the grading tree, the student's build or its logs holds a hidden test: {leaks[:5]}")
-    mode_ = os.stat(judge_folder).st_mode & 0o777
-    check(mode_ == 0o700, f"hidden: the judge's folder is the grader's only ({oct(mode_)})")
+    check(not leaks, f"hidden: no file of the grading tree, the student's build or its logs holds a "
+                     f"hidden test: {leaks[:5]}")
+    judge_mode_bits = os.stat(judge_folder).st_mode & 0o777
+    check(judge_mode_bits == 0o700, f"hidden: the judge's folder is the grader's only ({oct(judge_mode_bits)})")
 
 
 def main():

@@ -245,6 +245,9 @@ def results_json(rows, config, notes, seconds):
     top-level output, which students always see, counts only the exercises without any."""
     visibility = config.get("hidden_visibility", "after_published")
     tests = []
+    if config.get("hidden_cases") or any(r.get("hidden", 0) for r in rows):
+        # Which hidden test files and suites there are is not for them either.
+        notes = [n for n in notes if not n.startswith(("hidden tests", "suite '"))]
 
     def has_hidden(r):  # the grader's own list of the checker's cases: whatever doctest form
         return r.get("hidden", 0) > 0

@@ -328,8 +328,10 @@ def prepare(root, folder, hidden_by_step, steps, cache, jobs=2, timeout=3600, sa
             visible = os.path.join(build, "tests", f"test_step{n}")
             hidden = os.path.join(build, "tests", f"judge_hidden_step{n}") if hidden_by_step.get(n) else None
             listed = list_cases(hidden or visible)
-            cases = [Case(s, name, f, f.startswith(hidden_folder)) for s, name, f in listed
-                     if s.startswith("exercise ")]
+            # doctest names a case's file as the compiler saw it: relative to the build folder
+            # (a compiler cache rewrites paths so) or absolute.
+            cases = [Case(s, name, f, os.path.normpath(os.path.join(build, f)).startswith(hidden_folder))
+                     for s, name, f in listed if s.startswith("exercise ")]
             cases.sort(key=lambda c: c.hidden)  # stable: the visible ones first, in their order
             checkers[n] = Checker(visible, hidden, cases, folder)
         return checkers
@@ -509,6 +511,8 @@ def run_case(runner, checker, case, worker_binary, folder_name):
     finally:
         shutil.rmtree(wfolder, ignore_errors=True)
         shutil.rmtree(cfolder, ignore_errors=True)
+        if iso.drop:
+            remove_left_behind(iso.user.uid)
     if iso.deadline is not None and time.monotonic() >= iso.deadline:
         raise OutOfTime()
     status, reason = verdict(c, w, found)
@@ -584,6 +588,8 @@ def probe(runner, worker_binary, folder_name):
         _, w = run_pair(asker, worker_run)
     finally:
         shutil.rmtree(wfolder, ignore_errors=True)
+        if iso.drop:
+            remove_left_behind(iso.user.uid)
     if iso.deadline is not None and time.monotonic() >= iso.deadline:
         raise OutOfTime()
     if answered.get("ok"):
@@ -593,3 +599,35 @@ def probe(runner, worker_binary, folder_name):
         return ("failed", f"failed: the step's worker ended ({how}) before its first call "
                           "(the student's code runs before main?)")
     return (w.status, f"{w.reason} (the step's worker does not start)")
+
+
+# Without bubblewrap the student's user shares the machine's /tmp: what one worker leaves
+# there (a hidden case's input, say) a later worker could read.
+SHARED_WRITABLE = ("/tmp", "/var/tmp", "/dev/shm")
+
+
+def remove_left_behind(uid, places=SHARED_WRITABLE):
+    """Removes what the user `uid` owns in the folders every user may write (links are
+    removed, never followed); the count removed."""
+    removed = 0
+    for top in places:
+        for d, dirs, names in os.walk(top):
+            for n in dirs + names:
+                path = os.path.join(d, n)
+                try:
+                    info = os.lstat(path)
+                except OSError:
+                    continue
+                if info.st_uid != uid:
+                    continue
+                if n in dirs:
+                    dirs.remove(n)
+                try:
+                    if os.path.isdir(path) and not os.path.islink(path):
+                        shutil.rmtree(path)
+                    else:
+                        os.unlink(path)
+                    removed += 1
+                except OSError:
+                    pass
+    return removed

@@ -509,7 +509,7 @@ def expect_points(doc, label, failing=None, reason=""):
 
 def scenario_gradescope_read(work):
     """Reads the solutions (the bundle's reference tree), the hidden tests (the bundle's and
-    the grading tree's copies) and the results, and throws what it found."""
+    the judge's copies) and the results, and throws what it found."""
     if os.geteuid() != 0:
         return SKIPPED
     root = layout_root(work)
@@ -517,7 +517,7 @@ def scenario_gradescope_read(work):
     first = [e for e in exercises(ROOT) if f"{e.step:02d}" == first_step()][0]
     paths = [os.path.join(root, "source", "workbook", first.path),
              os.path.join(root, "source", "hidden", f"step{first_step()}_extra.cpp"),
-             os.path.join(w0, "src", "tests", "hidden", f"step{first_step()}_0.cpp"),
+             os.path.join(w0, "judge", "src", "tests", "hidden", f"step{first_step()}_0.cpp"),
              os.path.join(root, "source", "workbook", "tools", "grading", "grade.py"),
              os.path.join(root, "submission", first.path)]
     listing = ", ".join(json.dumps(p) for p in paths)

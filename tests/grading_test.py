@@ -22,6 +22,8 @@ usage: tests/grading_test.py SCENARIO WORK_DIR
                  exit 77, where bubblewrap cannot run)
   no-isolation   where bubblewrap cannot create namespaces (a fake bwrap that fails) the
                  grader refuses in one line, and grades with --no-isolation
+  judge-garbage  student code writes frames of its own into the judge's pipe: those
+                 exercises fail as a broken protocol, the others keep their points
   judge-forged, judge-exit-list, judge-hidden (and each with -fallback: without bubblewrap,
                  as root, the student's code as a user of its own; skipped, 77, when not root)
                  the judge against hostile student code: a result forged before main and an
@@ -899,6 +901,50 @@ def scenario_judge_exit_list(work, fallback):
     # tests"): its failed check shows its reference cases ran.
 
 
+# Student code that writes into the judge's pipe itself, then answers normally: a frame
+# claiming 2 GB, bytes that are no frame, a callback the checker never passed, a frame cut
+# short. Each must end its case as a broken protocol, not crash or hang the checker.
+GARBAGE = {
+    "1.3": "{char f[8] = {0}; uint32_t n = 0x80000000u; std::memcpy(f, &n, 4); f[4] = 2; (void)!write(out, f, 8);}",
+    "1.4": "{(void)!write(out, \"\\x05\\x00\\x00\\x00\\x09garbage\", 12);}",
+    "1.5": "{char f[12] = {4, 0, 0, 0, 4, 0, 0, 0, 7, 0, 0, 0}; (void)!write(out, f, 12);}",
+    "1.6": "{char f[8] = {100, 0, 0, 0, 2, 0, 0, 0}; (void)!write(out, f, 8); close(out);}",
+}
+
+
+def scenario_judge_garbage(work):
+    """Student code that writes frames of its own into the judge's pipe: each such exercise
+    scores 0 with 'breaks the protocol' (or its worker's end), the others keep their points,
+    and grading ends."""
+    mode = judge_mode(work, False)
+    if mode is None:
+        return SKIPPED
+    ids = [e.id for e in exercises(ROOT) if e.step == 1]
+    by_id = {e.id: e for e in exercises(ROOT)}
+    with tempfile.TemporaryDirectory(dir=work) as student:
+        student_tree(student)
+        for i, code in GARBAGE.items():
+            e = by_id[i]
+            path = os.path.join(student, e.path)
+            with open(path, encoding="utf-8") as f:
+                lines = f.read().split("\n")
+            lines.insert(e.begin + 1, "    { int in = -1, out = -1; const char* fds = std::getenv(\"BOXES_JUDGE_FDS\");"
+                                      " if (fds && std::sscanf(fds, \"%d,%d\", &in, &out) == 2) " + code + " }")
+            with open(path, "w", encoding="utf-8") as f:
+                f.write("#include <unistd.h>\n#include <cstdint>\n#include <cstdio>\n#include <cstdlib>\n"
+                        "#include <cstring>\n" + "\n".join(lines))
+        r, results = judge_grade(mode, student, os.path.join(work, "judge-garbage.json"))
+    check(r.returncode == 0, "garbage: grade.py exits 0")
+    for i in ids:
+        got = results.get(i, {})
+        if i in GARBAGE:
+            check(got.get("points") == 0 and ("breaks the protocol" in got.get("reason", "")
+                                              or "the worker ended" in got.get("reason", "")),
+                  f"garbage: exercise {i} scores 0: {got.get('status')!r} {got.get('reason', '')[:200]!r}")
+        else:
+            check(got.get("status") == "passed", f"garbage: exercise {i} keeps its points: {got.get('reason', '')[:200]!r}")
+
+
 # Grades in-process as Gradescope's run does (grade_into) and writes what Gradescope would
 # show (results_json) with the report's results and notes.
 GRADESCOPE_DRIVER = """import json, sys
@@ -1008,6 +1054,7 @@ def main():
                  "each-solved": scenario_each_solved}
     for kind in HOSTILE:
         scenarios[f"hostile-{kind}"] = lambda w, kind=kind: scenario_hostile(w, kind)
+    scenarios["judge-garbage"] = scenario_judge_garbage
     for name, fn in (("judge-forged", scenario_judge_forged), ("judge-exit-list", scenario_judge_exit_list),
                      ("judge-hidden", scenario_judge_hidden)):
         scenarios[name] = lambda w, fn=fn: fn(w, False)

@@ -10,13 +10,18 @@ What the student owns: the C++ sources and headers in the step folders (steps/NN
 data/. The grading tree is assembled in WORK/src (default build/grade/src): the reference's
 files, the step sources of the starter kit (so a file the student deleted is a stub, never
 the reference solution), then the student's step sources over them. An instructor's hidden
-tests (--hidden DIR) are doctest files named stepNN*.cpp; each is compiled into that step's
-test program (test_stepNN) and its TEST_SUITE("exercise N.M") cases count for exercise N.M.
+tests (--hidden DIR) are doctest files named stepNN*.cpp; their cases of a suite "exercise
+N.M", in whatever doctest form, count for exercise N.M.
 
-Each step's test program is built on its own, so a step that does not compile scores zero
-for its exercises (with the compiler's first error) and the other steps are still graded. Each
-test case of an "exercise N.M" suite runs as its own process; an exercise earns its points
-(from the reference's markers) when it has test cases and all of them pass.
+The judge (tools/grading/judge) runs every test case as a checker (the reference's tests
+and every expected value, built once for every student in WORK/judge: no student code, no
+student file compiled) and a worker (the student's functions behind a call server, no test
+at all), joined by pipes: the worker answers calls, the checker decides. Hidden tests are
+only ever in the judge's folder, in a checker of their own that runs the hidden cases only,
+after every visible case. Each step's worker is built on its own, so a step that does not
+compile scores zero for its exercises (with the compiler's first error) and the other steps
+are still graded. An exercise earns its points (from the reference's markers) when it has
+test cases and all of them pass.
 
 The student's code is untrusted: the configure, every build (the compilers read the
 student's sources) and every test case run in sandbox.py's sandbox (bubblewrap: the
@@ -24,8 +29,9 @@ system read-only, one writable folder: WORK/build for a build, a fresh folder pe
 case; a private /tmp, no network, no capabilities) with limits on wall-clock and CPU time,
 memory (address space) and output (--timeout, --memory, --output per test case;
 --build-timeout, --build-memory per step's build). Where bubblewrap cannot create
-namespaces the grader says so and refuses, unless --no-isolation. The tests write their
-results to a file, so what the student's code prints only counts against the output limit.
+namespaces the grader says so and refuses, unless --no-isolation. The checker writes its
+results to a file of its own, so what the student's code prints only counts against the
+output limit.
 A failing exercise says why: time limit, memory limit, output limit, crashed: SIGNAME,
 failed: <first failing assertion>, does not compile: <first error or the limit it hit>.
 The points table goes to the terminal, a JUnit XML file to --junit (default WORK/grade.xml;

@@ -15,7 +15,7 @@ types in judge/types_NN.hpp.
 """
 import os
 import re
-from dataclasses import dataclass, field
+from dataclasses import dataclass
 
 # Template parameters that stand for a callable: {exercise: {parameter name: signature}}.
 CALLBACKS = {
@@ -23,8 +23,19 @@ CALLBACKS = {
     "4.5": {"intersect": "bool(uint32_t, float)"},
     "5.4": {"blocks": "bool(size_t)"},
 }
-# A template parameter T of a number type: the exercise is served for each of these.
+# A template parameter T of a number type: the exercise is served for each type its file
+# instantiates (a line BOXES_INSTANTIATE(long double), say), else for these.
 NUMBER_VARIANTS = ("float", "double")
+
+
+def instantiated_types(text):
+    """The types a file instantiates its templates for: BOXES_INSTANTIATE(T) lines."""
+    found = []
+    for m in re.finditer(r"^BOXES_INSTANTIATE\(([^)]*)\)", text, re.M):
+        t = " ".join(m.group(1).split())
+        if t not in found:
+            found.append(t)
+    return tuple(found) or NUMBER_VARIANTS
 
 
 class StubError(Exception):
@@ -49,7 +60,7 @@ class Signature:
     const_method: bool = False
     body: tuple = (0, 0)  # [start, end) of the body's braces in the file's text
     after_marker: int = 0  # offset just after the marker's line
-    extra: dict = field(default_factory=dict)
+    number_types: tuple = NUMBER_VARIANTS  # what a number template parameter is served for
 
     @property
     def symbol(self):
@@ -67,7 +78,7 @@ class Signature:
         """[(variant name, {template parameter: type})]: one per served instantiation."""
         if not self.number_params:
             return [("", {})]
-        return [(v, {p: v for p in self.number_params}) for v in NUMBER_VARIANTS]
+        return [(v, {p: v for p in self.number_params}) for v in self.number_types]
 
     def self_param(self):
         if not self.cls:
@@ -238,7 +249,8 @@ def parse_signature(exercise, text):
         raise StubError(f"exercise {exercise.id}: no return type in {decl!r}")
     return Signature(exercise.id, exercise.path, number_params, ret, name, params,
                      const_method=bool(re.search(r"\bconst\b", after)),
-                     body=(body_start, body_end), after_marker=after_marker)
+                     body=(body_start, body_end), after_marker=after_marker,
+                     number_types=instantiated_types(text))
 
 
 # The generated pieces --------------------------------------------------------------------
@@ -295,7 +307,7 @@ def worker_source(signatures, headers):
     entries = []
     for s in signatures:
         for variant, types_of in s.variants():
-            fn = f"{s.symbol}{'_' + variant if variant else ''}"
+            fn = f"{s.symbol}{'_' + variant.replace(' ', '_') if variant else ''}"
             params = s.proxy_params()
             body = [f"    ::boxes::judge::Slot<{substitute(p.type, types_of)}> a{i}(r);"
                     for i, p in enumerate(params)]

@@ -372,21 +372,48 @@ class Ends:
     result: bytes  # the checker's doctest XML (None when it wrote none)
 
 
-def run_pair(checker_run, worker_run):
+# The shared slots of the protocol's fast path (wire.hpp's SharedChannel: two slots of
+# 1 MiB and their counters).
+SHARED_BYTES = 2 * (3 * 64 + (1 << 20))
+
+
+def shared_slots():
+    """Two descriptors of one sealed memfd of SHARED_BYTES zeros (its size cannot change:
+    a worker that shrank it would make the checker fault), or None where there is none."""
+    try:
+        fd = os.memfd_create("boxes-judge", os.MFD_CLOEXEC | os.MFD_ALLOW_SEALING)
+    except (AttributeError, OSError):
+        return None
+    try:
+        os.ftruncate(fd, SHARED_BYTES)
+        import fcntl as _fcntl
+        _fcntl.fcntl(fd, _fcntl.F_ADD_SEALS, _fcntl.F_SEAL_SHRINK | _fcntl.F_SEAL_GROW | _fcntl.F_SEAL_SEAL)
+        return fd, os.dup(fd)
+    except (AttributeError, OSError):
+        os.close(fd)
+        return None
+
+
+def run_pair(checker_run, worker_run, fast=False):
     """Runs the worker (worker_run(pass_fds, fds_text)) on a thread and the checker
-    (checker_run likewise) on this one, joined by two pipes; returns (checker's result,
-    worker's result). Each run function must hand its descriptors to sandbox.run, which
-    closes this process's copies once its command started: then either command sees the
-    end of the pipes when the other ends."""
+    (checker_run likewise) on this one, joined by two pipes (and with `fast`, shared slots
+    where both can have a core: wire.hpp); returns (checker's result, worker's result).
+    Each run function must hand its descriptors to sandbox.run, which closes this process's
+    copies once its command started: then either command sees the end of the pipes when
+    the other ends."""
     to_worker = os.pipe()
     to_checker = os.pipe()
     worker_fds = (to_worker[0], to_checker[1])
     checker_fds = (to_checker[0], to_worker[1])
+    shared = shared_slots() if fast else None
+    if shared:
+        worker_fds += (shared[0],)
+        checker_fds += (shared[1],)
     box = {}
 
     def worker():
         try:
-            box["worker"] = worker_run(worker_fds, f"{worker_fds[0]},{worker_fds[1]}")
+            box["worker"] = worker_run(worker_fds, ",".join(map(str, worker_fds)))
         except BaseException as e:  # sandbox.Stopped, say: raised here after the checker ends
             box["error"] = e
 
@@ -398,7 +425,7 @@ def run_pair(checker_run, worker_run):
             os.close(fd)
         raise
     try:
-        checker = checker_run(checker_fds, f"{checker_fds[0]},{checker_fds[1]}")
+        checker = checker_run(checker_fds, ",".join(map(str, checker_fds)))
     finally:
         thread.join()
     if "error" in box:
@@ -505,7 +532,7 @@ def run_case(runner, checker, case, worker_binary, folder_name):
                            pass_fds=fds)
 
     try:
-        c, w = run_pair(checker_run, worker_run)
+        c, w = run_pair(checker_run, worker_run, fast=sandbox.usable_cpus() >= 2)
         data = read_result(result)
         found = [x for x in case_results(data) if x.name == case.name] if data else []
     finally:

@@ -74,12 +74,10 @@ constexpr const char* variantOf() {
 inline Session& checkerSession(const char* id) {
     Session& s = Session::get();
     if (!s.connected()) {
-        int in, out;
-        if (!parseFds(std::getenv("BOXES_JUDGE_FDS"), in, out))
+        if (!s.connect(std::getenv("BOXES_JUDGE_FDS")))
             throw WorkerError(std::string("exercise ") + id +
                               ": this test program is the grader's checker; its exercises run "
                               "in a worker it was not given (BOXES_JUDGE_FDS)");
-        s.connect(in, out);
         s.serve = [&s](Kind, const std::string& payload) {
             // A callback: the worker names one the calls in progress registered.
             Reader r(payload);

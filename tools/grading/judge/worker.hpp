@@ -112,14 +112,12 @@ inline void serveCall(std::span<const Entry> table, const std::string& payload) 
 // (std::_Exit: no static destructor or atexit handler of the student's runs after the last
 // answer).
 inline int serve(std::span<const Entry> table) {
-    int in, out;
-    if (!parseFds(std::getenv("BOXES_JUDGE_FDS"), in, out)) {
+    Session& s = Session::get();
+    s.worker = true;
+    if (!s.connect(std::getenv("BOXES_JUDGE_FDS"))) {
         std::fprintf(stderr, "judge worker: run by the grader only (BOXES_JUDGE_FDS)\n");
         return 2;
     }
-    Session& s = Session::get();
-    s.worker = true;
-    s.connect(in, out);
     s.serve = [table](Kind, const std::string& payload) { serveCall(table, payload); };
     for (;;) {
         Kind kind;

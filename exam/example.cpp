@@ -176,7 +176,7 @@ ChainedQuestion exampleQuestionOne(Rng& rng, bool lectureNumbers) {
                   ". Determine the normalized direction of r.";
     b.parts = {numbersPart("the normalized direction of r", values(d), 3)};
     Vec3d point = s.centre + g.sx * s.u + g.sy * s.v;
-    b.solution = {"the point: M + " + num(g.sx) + " u + " + num(g.sy) + " v = " + vec(point),
+    b.solution = {"the point: M" + plus(g.sx) + " u" + plus(g.sy) + " v = " + vec(point),
                   "r = (point - E) / |point - E| = " + vec(point - g.eye) + " / " +
                       num(glm::length(point - g.eye)) + " = " + vec(d)};
     if (g.sx == 0.0 && g.sy == 0.0) b.solution.push_back("(through the centre: simply V / |V|)");
@@ -194,8 +194,8 @@ ChainedQuestion exampleQuestionOne(Rng& rng, bool lectureNumbers) {
     double tPlane = -(ne + g.planeD) / nd;
     cq.solution = {
         "the plane is N . P + d = 0 with N = " + vec(g.planeNormal) + ", d = " + num(g.planeD),
-        "t = -(N . E + d) / (N . r) = -(" + num(ne) + " + " + num(g.planeD) + ") / " + num(nd) +
-            " = " + num(tPlane),
+        "t = -(N . E + d) / (N . r) = -(" + num(ne) + plus(g.planeD) + ") / " + num(nd) + " = " +
+            num(tPlane),
         tPlane < 0.0 ? "t < 0: the plane lies behind the eye, no intersection"
                      : "P = E + t r = " + vec(r.at(tPlane))};
     c.parts.emplace_back("r against a plane", cq);

@@ -14,6 +14,10 @@ std::string num(double v) {
     return s.str();
 }
 
+std::string plus(double v) {
+    return v < 0.0 && num(v) != "0" ? " - " + num(-v) : " + " + num(v);
+}
+
 std::string vec(const Vec3d& v) {
     return "(" + num(v.x) + ", " + num(v.y) + ", " + num(v.z) + ")";
 }

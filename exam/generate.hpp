@@ -40,6 +40,8 @@ struct Rng {
 
 // "2.5", "-0.333333": six significant digits, never "-0".
 std::string num(double v);
+// " + 3", " - 3": a number after another in a sum.
+std::string plus(double v);
 // "(1, 2.5, -3)"
 std::string vec(const Vec3d& v);
 std::vector<double> values(const Vec3d& v);

@@ -158,8 +158,8 @@ Question rayPlane(Rng& rng, Question q) {
                              (denom == 0.0 ? ": the ray is parallel to the plane, no hit" : ""));
         if (denom != 0.0) {
             double tt = -(glm::dot(o, n) + pd) / denom;
-            q.solution.push_back("t = -(O . N + d) / (D . N) = -(" + num(glm::dot(o, n)) + " + " +
-                                 num(pd) + ") / " + num(denom) + " = " + num(tt));
+            q.solution.push_back("t = -(O . N + d) / (D . N) = -(" + num(glm::dot(o, n)) +
+                                 plus(pd) + ") / " + num(denom) + " = " + num(tt));
             q.solution.push_back(tt < 0.0 ? "t < 0: the plane lies behind the ray's origin, no hit"
                                           : "P = O + t D = " + vec(o + tt * d));
         }

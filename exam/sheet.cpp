@@ -128,7 +128,7 @@ std::string sheetHtml(const MockSheet& sheet, double minutes, bool key) {
          "question 2 its second with more of the lecture's terms; questions 3 and 4 ask the "
          "rest of what the lecture expects (light transport; vectors, boxes, efficiency). The "
          "lecture gives no points per part: the points here are the workbook's.</p>"
-      << "<p>Give numbers to three decimals or exactly (sqrt(10) - 1); they count within "
+      << "<p>Give numbers to three decimals or exactly, as sqrt(10) - 1: "
       << escape(toleranceText()) << ". Write <i>none</i> where a ray hits nothing.</p>"
       << "<p>To have it marked: type the answers into the answer file, one a line, and run "
          "<code>./workbook exam --mock --seed "

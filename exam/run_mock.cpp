@@ -169,18 +169,22 @@ int runMock(const MockSheet& sheet, const MockRun& run, std::ostream& out) {
     size_t slot = 0;
     for (const MockQuestion& q : sheet.questions) {
         if (ended) break;
-        out << "\n== Question " << q.number << " (" << points(q.points()) << " points): " << q.title
+        out << "\n"
+            << wrapText("== Question " + std::to_string(q.number) + " (" + points(q.points()) +
+                            " points): " + q.title,
+                        run.width, 3)
             << "\n";
         if (!q.statement.empty()) out << wrapText(q.statement, run.width, 2) << "\n";
         for (const MockPart& p : q.parts) {
             if (ended) break;
             printPart(p, out, run.width);
             for (const Part& line : p.question.parts) {
-                std::string prompt = "   " + slots[slot].label + " " + line.prompt + "?";
-                if (answers.interactive())
-                    prompt = "   [" + clockText(clock.left()) + " left] " + prompt.substr(3);
                 for (;;) {
-                    // The space after the question mark survives the wrapping.
+                    // The clock's time left when asked; the space after the question mark
+                    // survives the wrapping.
+                    std::string prompt = "   " + slots[slot].label + " " + line.prompt + "?";
+                    if (answers.interactive())
+                        prompt = "   [" + clockText(clock.left()) + " left] " + prompt.substr(3);
                     out << wrapText(prompt, run.width, 5) << " " << std::flush;
                     std::optional<std::string> a = answers.next(clock);
                     if (!a) {

@@ -6,6 +6,7 @@ look at.
 
 usage: exam_sheet_test.py EXAM_PROGRAM WORK_DIR [--screenshots]
 Exit 0 when both pages pass, 1 when one fails, 77 (ctest's skip) without Chromium."""
+import html as html_lib
 import json
 import os
 import re
@@ -107,7 +108,7 @@ def main():
         if not m:
             failures.append(f"{name}: Chromium ran no layout check ({dom.stderr.strip()[:200]})")
             continue
-        result = json.loads(m.group(1).replace("&quot;", '"').replace("&amp;", "&"))
+        result = json.loads(html_lib.unescape(m.group(1)))
         print(f"{name}: {json.dumps(result)}")
         for p in result["problems"]:
             failures.append(f"{name}: {p}")

@@ -49,29 +49,68 @@ class Classify(unittest.TestCase):
         self.assertEqual((r.stdout, r.stderr, r.seconds, r.ok), (b"out", b"err", 2.5, True))
 
 
+def mounts(prefix):
+    """[(option, destination)] of the mounts a bubblewrap prefix makes."""
+    found = []
+    for i, arg in enumerate(prefix):
+        if arg in ("--ro-bind", "--bind"):
+            found.append((arg, prefix[i + 2]))
+        elif arg in ("--tmpfs", "--dir", "--symlink", "--dev", "--proc"):
+            found.append((arg, prefix[i + 2] if arg == "--symlink" else prefix[i + 1]))
+    return found
+
+
 class BubblewrapPrefix(unittest.TestCase):
-    def test_hidden_folders_are_covered_and_readable_ones_shown(self):
+    def test_only_the_system_and_the_given_folders_are_there(self):
         home = os.path.expanduser("~")
-        work = os.path.join(home, "boxes-test-no-such-folder")
-        # A path made absent here: "/nonexistent" is a system user's home, which a tool
-        # running as such a user may create.
-        with tempfile.TemporaryDirectory() as scratch:
-            absent = os.path.join(scratch, "absent")
-        prefix = sandbox.bwrap_prefix([work], work, 1 << 20, hidden=["/tmp", home, absent],
-                                      readable=["/usr"])
+        work = os.path.join(home, "boxes-test-no-such-folder", "w0", "build")
+        data = "/usr/share/doc"  # a folder the test program reads, inside the system
+        prefix = sandbox.bwrap_prefix([work], work, 1 << 20, hidden=[home, "/usr/share"],
+                                      readable=[data])
         text = " ".join(prefix)
-        self.assertIn(f"--tmpfs {home}", text)
-        self.assertIn(f"--remount-ro {home}", text)
-        self.assertNotIn(f"--tmpfs {absent}", text)  # only folders that exist
-        self.assertIn(f"--size {1 << 20} --tmpfs /tmp", text)
-        self.assertIn("--ro-bind /usr /usr", text)
+        bound = {dest for option, dest in mounts(prefix) if option in ("--ro-bind", "--bind")}
+        self.assertEqual(bound, set(sandbox.SYSTEM_DIRS) | {work, data} |
+                         {d for d in sandbox.SYSTEM_LINKS if os.path.isdir(d) and not os.path.islink(d)})
+        self.assertNotIn("--ro-bind / /", text)  # not the whole machine, covered in places
+        self.assertNotIn(f"--tmpfs {home}", text)  # absent, nothing to cover
         self.assertIn(f"--bind {work} {work}", text)
         self.assertEqual(prefix[prefix.index("--chdir") + 1], work)
-        for flag in ("--unshare-all", "--cap-drop", "--die-with-parent", "--disable-userns"):
+        # The folders above the writable one are made reachable (0755), not 0700.
+        for up in (home, os.path.dirname(os.path.dirname(work))):
+            self.assertIn(f"--perms 0755 --dir {up}", text)
+        # A hidden folder the system shows is covered, a readable one inside it shown again.
+        self.assertIn("--tmpfs /usr/share", text)
+        self.assertLess(prefix.index("/usr/share"), prefix.index(data))
+        self.assertLess(prefix.index(data), prefix.index("--remount-ro"))
+        self.assertIn(f"--size {1 << 20} --perms 1777 --tmpfs /tmp", text)
+        self.assertIn(f"--size {1 << 20} --perms 1777 --tmpfs /dev/shm", text)
+        for flag in ("--unshare-all", "--unshare-user", "--cap-drop", "--die-with-parent", "--disable-userns"):
             self.assertIn(flag, prefix)
-        # The cover goes on before the writable bind inside it, the remount after.
-        self.assertLess(prefix.index("--tmpfs"), prefix.index("--bind"))
-        self.assertLess(prefix.index("--bind"), prefix.index("--remount-ro"))
+
+    def test_a_scratch_folder_is_a_sized_tmpfs_with_its_outputs_bound(self):
+        scratch, result = "/w/case", "/w/case/result.xml"
+        prefix = sandbox.bwrap_prefix([], scratch, 1 << 20, scratch=scratch, scratch_bytes=3 << 20,
+                                      outputs=[result])
+        text = " ".join(prefix)
+        self.assertIn(f"--size {3 << 20} --perms 1777 --tmpfs {scratch}", text)
+        self.assertIn(f"--bind {result} {result}", text)
+        self.assertLess(text.index(f"--tmpfs {scratch}"), text.index(f"--bind {result}"))
+        self.assertNotIn(f"--bind {scratch} ", text)  # nothing of the host folder but the result
+
+    def test_as_root_the_command_becomes_a_user_of_its_own(self):
+        user = sandbox.User("uid 2130706500", 2130706500, 2130706500)
+        prefix = sandbox.bwrap_prefix(["/w"], "/w", 1 << 20, user=user)
+        self.assertNotIn("--unshare-user", prefix)  # its id outside is the user's, not root's
+        self.assertNotIn("--unshare-all", prefix)
+        for flag in ("--unshare-pid", "--unshare-net", "--unshare-ipc", "--die-with-parent"):
+            self.assertIn(flag, prefix)
+        kept = [prefix[i + 1] for i, a in enumerate(prefix) if a == "--cap-add"]
+        self.assertEqual(set(kept), {"CAP_SETUID", "CAP_SETGID", "CAP_SETPCAP", "CAP_DAC_OVERRIDE"})
+        become = sandbox.become(user)
+        self.assertTrue(become[0].endswith("setpriv"))
+        for flag in ("--reuid=2130706500", "--regid=2130706500", "--clear-groups", "--inh-caps=-all",
+                     "--bounding-set=-all", "--no-new-privs"):
+            self.assertIn(flag, become)
 
 
 class OlderBubblewrap(unittest.TestCase):

@@ -4,10 +4,16 @@ runs (grade.py imports this module), and tools/grading/sandbox.sh on the command
 usage: tools/grading/sandbox.sh [--time S] [--memory MB] [--output MB] [--processes N]
                                 [--dir DIR] [--no-isolation [--user NAME]] -- COMMAND [ARGS...]
 
-Isolation (bubblewrap): the whole system read-only, DIR (default: a fresh temporary folder)
-the only writable place and the working directory, a private /tmp of at most the output
-limit, no network (an own, empty network namespace), an own PID namespace, no capabilities
-and no further user namespaces (even when the grader runs as root), killed with its parent.
+Isolation (bubblewrap): the command sees the system's programs and libraries read-only
+(/usr, /etc and the links of a merged /usr; nothing else of the machine: no home, no
+/work, /srv or /var, no other student's folder), the folders it is given (DIR, default: a
+fresh temporary folder, the only writable place and the working directory), a private /tmp
+and /dev/shm of at most the output limit each, no network (an own, empty network
+namespace), an own PID namespace, no capabilities, killed with its parent. As root it runs
+as a user id of its own that owns no file of the machine (a fresh one per command, from
+BOXES_SANDBOX_UID_BASE, default 2130706432; setpriv drops to it inside the sandbox) and DIR
+is lent to that user for the run; otherwise as "nobody" in a user namespace, with no
+further user namespaces.
 Limits (setrlimit, inherited by every process the command starts): wall-clock seconds (the
 whole run), CPU seconds (per process: the wall time times the cores, so a busy loop in
 every thread still stops), address space per process, the size of any file written, and
@@ -28,9 +34,12 @@ DIR/stderr.txt (their first bytes, up to the output limit) and one line
 "sandbox: RESULT" goes to stdout: ok | failed: exit N | time limit | memory limit |
 output limit | crashed: SIGNAME. Exit status: 0 ok, 1 failed, 3 limit or crash, 2 usage
 or refused (bubblewrap cannot create namespaces here and no --no-isolation).
-Environment: BOXES_BWRAP names the bubblewrap program (default: bwrap on PATH).
+Environment: BOXES_BWRAP names the bubblewrap program (default: bwrap on PATH);
+BOXES_SANDBOX_SYSTEM adds folders the sandbox shows read-only (colon-separated, e.g. a
+compiler under /opt).
 """
 import argparse
+import contextlib
 import ctypes
 import functools
 import itertools
@@ -41,6 +50,7 @@ import resource
 import selectors
 import shutil
 import signal
+import stat
 import subprocess
 import sys
 import tempfile
@@ -66,6 +76,7 @@ class Limits:
     output_mb: float = 16.0  # stdout + stderr together, and any one file written
     file_mb: float = 0.0  # any one file written, when it must differ from output_mb (a build)
     processes: int = 256  # processes and threads the command may have at once
+    disk_mb: float = 64.0  # all files of a scratch folder together (run's `scratch`, isolated)
 
     def cpu_seconds(self):
         return int(self.seconds * usable_cpus()) + 1
@@ -241,37 +252,106 @@ def bwrap_has(option):
     return option in _bwrap_help(bwrap_program()).split()
 
 
-def _namespaces():
-    # An own user namespace as "nobody" with no capabilities: root outside gets no power
-    # inside (no remounting the read-only system, no raising the limits). Where bubblewrap
-    # is older than 0.8 the sandbox may create further user namespaces; the mounts it
-    # inherits stay locked in them, and the limits were set outside.
-    flags = ["--unshare-all", "--unshare-user", "--uid", "65534", "--gid", "65534", "--cap-drop", "ALL"]
-    if bwrap_has("--disable-userns"):
-        flags.append("--disable-userns")
+def _namespaces(user=None):
+    """Without `user`: an own user namespace as "nobody" with no capabilities: root outside
+    gets no power inside (no remounting the read-only system, no raising the limits). Where
+    bubblewrap is older than 0.8 the sandbox may create further user namespaces; the mounts
+    it inherits stay locked in them, and the limits were set outside. With `user` (the
+    grader is root): no user namespace, so that the command's user id is `user`'s outside
+    too (one that owns nothing); bubblewrap keeps only what it needs to enter that user's
+    working folder and what setpriv needs to become it (all of which setpriv then drops)."""
+    if user is None:
+        flags = ["--unshare-all", "--unshare-user", "--uid", "65534", "--gid", "65534", "--cap-drop", "ALL"]
+        if bwrap_has("--disable-userns"):
+            flags.append("--disable-userns")
+    else:
+        flags = ["--unshare-ipc", "--unshare-pid", "--unshare-net", "--unshare-uts", "--unshare-cgroup-try",
+                 "--cap-drop", "ALL", "--cap-add", "CAP_SETUID", "--cap-add", "CAP_SETGID",
+                 "--cap-add", "CAP_SETPCAP", "--cap-add", "CAP_DAC_OVERRIDE"]  # to enter the user's folder
     return flags + ["--die-with-parent", "--new-session"]
 
 
-def bwrap_prefix(writable, cwd, tmp_bytes, hidden=(), readable=()):
-    """bubblewrap arguments: the system read-only, `hidden` folders replaced by empty ones,
-    `readable` folders (inside hidden ones) shown again read-only, `writable` folders
-    read-write, a private /tmp of tmp_bytes, /dev and /proc of the sandbox's own."""
-    prefix = [bwrap_program(), "--ro-bind", "/", "/", "--dev", "/dev", "--proc", "/proc"]
+def setpriv_program():
+    return shutil.which("setpriv", path="/usr/bin:/bin") or ""
+
+
+def become(user):
+    """The command prefix, inside the sandbox, that becomes `user` for good: its ids, no
+    groups, no capabilities (bounding set too), no new privileges (setuid programs stay
+    what they are)."""
+    return [setpriv_program(), f"--reuid={user.uid}", f"--regid={user.gid}", "--clear-groups",
+            "--inh-caps=-all", "--bounding-set=-all", "--no-new-privs", "--"]
+
+
+# What the sandbox shows of the system, read-only: the programs, libraries and headers
+# (/usr), their configuration (/etc: the compilers' alternatives, ld.so.cache), and the
+# top-level links of a merged /usr (or the folders themselves where /usr is not merged).
+SYSTEM_DIRS = ("/usr", "/etc")
+SYSTEM_LINKS = ("/bin", "/sbin", "/lib", "/lib32", "/lib64", "/libx32")
+
+
+def system_mounts():
+    args = []
+    extra = [d for d in os.environ.get("BOXES_SANDBOX_SYSTEM", "").split(":") if d.startswith("/")]
+    for d in SYSTEM_DIRS + tuple(extra):
+        if os.path.isdir(d):
+            args += ["--ro-bind", d, d]
+    for d in SYSTEM_LINKS:
+        if os.path.islink(d):
+            args += ["--symlink", os.readlink(d), d]
+        elif os.path.isdir(d):
+            args += ["--ro-bind", d, d]
+    return args
+
+
+def _inside(path, folder):
+    return path == folder or path.startswith(folder.rstrip("/") + "/")
+
+
+def bwrap_prefix(writable, cwd, tmp_bytes, hidden=(), readable=(), scratch=None, scratch_bytes=0,
+                 outputs=(), user=None):
+    """bubblewrap arguments: the system read-only (system_mounts) and nothing else of the
+    machine but the folders given: `readable` ones read-only, `writable` ones read-write,
+    `scratch` (the working folder) a fresh tmpfs of scratch_bytes with the host files
+    `outputs` bound into it read-write; a private /tmp and /dev/shm of tmp_bytes each, /dev
+    and /proc of the sandbox's own. `hidden` folders inside the system folders are replaced
+    by empty ones (folders outside them are not there anyway). `user` (as root): the
+    namespaces for becoming that user (become)."""
+    prefix = [bwrap_program()] + system_mounts() + ["--dev", "/dev", "--proc", "/proc"]
+    size = ["--size", str(int(tmp_bytes))] if bwrap_has("--size") else []
     covers = []
     for d in hidden:
-        inside_another = any(d != h and d.startswith(h.rstrip("/") + "/") for h in list(hidden) + ["/tmp"])
-        if os.path.isdir(d) and d not in ("/", "/tmp") and not inside_another:
+        inside_another = any(d != h and _inside(d, h) for h in hidden)
+        shown = any(_inside(d, s) for s in SYSTEM_DIRS)
+        if os.path.isdir(d) and shown and d not in SYSTEM_DIRS and not inside_another:
             covers.append(d)
             prefix += ["--tmpfs", d]
-    prefix += (["--size", str(int(tmp_bytes))] if bwrap_has("--size") else []) + ["--tmpfs", "/tmp"]
+    prefix += size + ["--perms", "1777", "--tmpfs", "/tmp"]
+    prefix += size + ["--perms", "1777", "--tmpfs", "/dev/shm"]
+    # The folders above a bound one: bubblewrap would make them 0700 (a user that is not
+    # root could not reach the folder by its path); those of the system exist already.
+    made = set(SYSTEM_DIRS) | {"/", "/tmp", "/dev", "/proc"}
+    for d in [r for r in readable if os.path.exists(r)] + list(writable) + ([scratch] if scratch else []):
+        parts = d.strip("/").split("/")[:-1]
+        for k in range(1, len(parts) + 1):
+            up = "/" + "/".join(parts[:k])
+            shown = any(_inside(up, s) for s in SYSTEM_DIRS) and not any(_inside(up, c) for c in covers)
+            if up not in made and not shown:
+                made.add(up)
+                prefix += ["--perms", "0755", "--dir", up]
     for d in readable:
         if os.path.exists(d):
             prefix += ["--ro-bind", d, d]
     for d in writable:
         prefix += ["--bind", d, d]
+    if scratch:
+        prefix += (["--size", str(int(scratch_bytes))] if bwrap_has("--size") else []) + \
+            ["--perms", "1777", "--tmpfs", scratch]
+        for f in outputs:
+            prefix += ["--bind", f, f]
     for d in covers:  # the empty covers stay read-only (after the binds made their mount points)
         prefix += ["--remount-ro", d]
-    return prefix + ["--chdir", cwd] + _namespaces()
+    return prefix + ["--chdir", cwd] + _namespaces(user)
 
 
 def _user_tasks(uid):
@@ -481,6 +561,7 @@ def _set_limits(limits, cgroup=None, nproc=None, user=None):
         resource.setrlimit(resource.RLIMIT_AS, (limits.memory_mb << 20,) * 2)
         resource.setrlimit(resource.RLIMIT_FSIZE, (file_bytes,) * 2)  # SIGXFSZ past it
         resource.setrlimit(resource.RLIMIT_CORE, (0, 0))
+        os.umask(0o022)  # what a build makes, the tests (another user, maybe) can read
         if user is not None:  # last: the limits above are set while still root
             os.setgroups([])
             os.setgid(user.gid)
@@ -496,46 +577,149 @@ def _signal_name(number):
 
 
 def run(cmd, limits, writable=(), cwd=None, isolate=True, keep=1 << 20, env=None, hidden=(),
-        readable=(), user=None):
+        readable=(), user=None, scratch=None, outputs=()):
     """Runs cmd under the sandbox and limits; returns a Result. `writable`: the folders the
-    command may write (cwd, default the first of them, is one of them when isolated);
-    `hidden`: folders it must not read (they look empty), `readable`: folders inside those
-    it reads after all. `user` (a User; without isolation, as root): the command runs as
-    that user under RLIMIT_NPROC, and every process of that user is killed when it ends
-    (`hidden`, `readable` and `writable` are then the file permissions' business). Raises
-    Stopped after stop_all()."""
+    command may write (cwd, default the first of them or `scratch`, is one of them when
+    isolated); `readable`: the folders it may read besides the system (isolated; nothing
+    else of the machine is there); `hidden`: folders of the system it must not read (they
+    look empty). `scratch`: a folder the caller made, the command's working folder: when
+    isolated a fresh tmpfs of limits.disk_mb there, of which only the files `outputs`
+    (paths inside it, made empty here) reach the host; else the folder itself. `user` (a
+    User; as root): the command runs as that user; isolated, as root, without `user`: as a
+    fresh user id of its own (box_user). The writable folders, `scratch` and `outputs` are
+    that user's while it runs (lent, then the caller's again). Without isolation every
+    process of `user` is killed when the command ends, and `hidden`, `readable` and
+    `writable` are the file permissions' business. Raises Stopped after stop_all()."""
     if _stop.is_set():
         raise Stopped()
     writable = [os.path.abspath(d) for d in writable]
     hidden = [os.path.abspath(d) for d in hidden]
     readable = [os.path.abspath(d) for d in readable]
-    cwd = os.path.abspath(cwd or (writable[0] if writable else os.getcwd()))
+    scratch = scratch and os.path.abspath(scratch)
+    outputs = [os.path.abspath(f) for f in outputs]
+    cwd = os.path.abspath(cwd or scratch or (writable[0] if writable else os.getcwd()))
     output_bytes = int(limits.output_mb * (1 << 20))
-    full = list(cmd)
-    if isolate:
-        full = bwrap_prefix(writable or [cwd], cwd, output_bytes, hidden, readable) + ["--"] + full
-    if user is not None and not isolate:
-        if os.geteuid() != 0:
-            raise ValueError("sandbox: running commands as another user needs root")
-        _become_subreaper()
-        with _user_lock(user):
-            kill_user(user)  # nothing of that user runs beside the command
-            try:
-                result = _run_limited(full, limits, cwd, isolate, keep, env, output_bytes, None,
-                                      _user_tasks(user.uid) + limits.processes, user)
-            finally:
-                kill_user(user)
-                _reap_orphans(user)
-    else:
-        cgroup, nproc = _process_limit(limits)
-        try:
-            result = _run_limited(full, limits, cwd, isolate, keep, env, output_bytes, cgroup, nproc)
-        finally:
-            if cgroup:
-                _remove_cgroup(cgroup)
+    for f in outputs:
+        with open(f, "wb"):
+            pass
+    if user is not None and os.geteuid() != 0:
+        raise ValueError("sandbox: running commands as another user needs root")
+    if not isolate:
+        if user is not None:
+            return _run_as(user, list(cmd), limits, cwd, keep, env, output_bytes,
+                           writable + ([scratch] if scratch else []) + outputs)
+        return _run_here(list(cmd), limits, cwd, False, keep, env, output_bytes)
+    with _box_user(user) as box:
+        full = bwrap_prefix(writable or ([] if scratch else [cwd]), cwd, output_bytes, hidden, readable,
+                            scratch, limits.disk_mb * (1 << 20), outputs, box) + ["--"]
+        full += (become(box) if box else []) + list(cmd)
+        with _lent(writable + outputs if box else [], box):
+            return _run_here(full, limits, cwd, True, keep, env, output_bytes)
+
+
+def _run_here(full, limits, cwd, isolate, keep, env, output_bytes):
+    """As the grader's user (bubblewrap itself, as root, drops to the box user inside)."""
+    cgroup, nproc = _process_limit(limits)
+    try:
+        result = _run_limited(full, limits, cwd, isolate, keep, env, output_bytes, cgroup, nproc)
+    finally:
+        if cgroup:
+            _remove_cgroup(cgroup)
     if _stop.is_set():  # killed by stop_all: its result is not the command's
         raise Stopped()
     return result
+
+
+def _run_as(user, full, limits, cwd, keep, env, output_bytes, lent):
+    """Without isolation, as root: as `user`, alone (every process of it is killed before
+    and after), under RLIMIT_NPROC."""
+    _become_subreaper()
+    with _user_lock(user), _lent(lent, user):
+        kill_user(user)  # nothing of that user runs beside the command
+        try:
+            result = _run_limited(full, limits, cwd, False, keep, env, output_bytes, None,
+                                  _user_tasks(user.uid) + limits.processes, user)
+        finally:
+            kill_user(user)
+            _reap_orphans(user)
+    if _stop.is_set():
+        raise Stopped()
+    return result
+
+
+BOX_UID_BASE = 2130706432  # 0x7F000000: far above login users, system users and subuid ranges
+_BOX_SLOTS = 64  # sandboxed commands of one grader at once
+_box_free = list(range(_BOX_SLOTS))
+_box_lock = threading.Lock()
+_warned_no_setpriv = False
+
+
+@contextlib.contextmanager
+def _box_user(user):
+    """The user an isolated command becomes: `user` when given; as root a fresh user id of
+    its own, which no account, file or other command of this machine has (from
+    BOXES_SANDBOX_UID_BASE, by this process's id and a free slot); else None (bubblewrap's
+    "nobody" in a user namespace). Without setpriv, root keeps the user namespace, whose
+    nobody is root outside (said once)."""
+    global _warned_no_setpriv
+    if os.geteuid() != 0:
+        yield None
+        return
+    if not setpriv_program():
+        if not _warned_no_setpriv:
+            _warned_no_setpriv = True
+            print("sandbox: WARNING: no setpriv (util-linux): as root the sandbox runs as root's "
+                  "user outside its namespace", file=sys.stderr)
+        yield None
+        return
+    if user is not None:
+        yield user
+        return
+    with _box_lock:
+        if not _box_free:
+            raise RuntimeError(f"sandbox: more than {_BOX_SLOTS} sandboxed commands at once")
+        slot = _box_free.pop(0)
+    try:
+        base = int(os.environ.get("BOXES_SANDBOX_UID_BASE") or BOX_UID_BASE)
+        uid = base + (os.getpid() % 4096) * _BOX_SLOTS + slot
+        yield User(f"uid {uid}", uid, uid)
+    finally:
+        with _box_lock:
+            _box_free.append(slot)
+
+
+def _chown_tree(path, uid, gid):
+    """chown -R without following links; a file with more than one hard link is left alone
+    (it may be another's file, linked in)."""
+    if not os.path.lexists(path):
+        return
+    os.lchown(path, uid, gid)
+    for d, dirs, files in os.walk(path):
+        for n in dirs + files:
+            p = os.path.join(d, n)
+            try:
+                info = os.lstat(p)
+                if stat.S_ISDIR(info.st_mode) or info.st_nlink == 1:
+                    os.lchown(p, uid, gid)
+            except FileNotFoundError:
+                pass
+
+
+@contextlib.contextmanager
+def _lent(paths, user):
+    """The folders (with what is in them) and files `paths` are `user`'s while the command
+    runs, the caller's again afterwards: what the command made there, the grader then owns,
+    and no later command of that user can change it."""
+    if user is None or not paths:
+        yield
+        return
+    for p in paths:
+        _chown_tree(p, user.uid, user.gid)
+    try:
+        yield
+    finally:
+        for p in paths:
+            _chown_tree(p, os.getuid(), os.getgid())
 
 
 def _run_limited(full, limits, cwd, isolate, keep, env, output_bytes, cgroup, nproc, user=None):
@@ -721,9 +905,11 @@ def main(argv):
         print(f"sandbox: the command's folder: {folder}", file=sys.stderr)
     if user:
         os.chown(folder, user.uid, user.gid)
+    # The command's own program, when it is a file of the caller's, is shown read-only.
+    program = shutil.which(cmd[0]) if os.sep not in cmd[0] else os.path.abspath(cmd[0])
     r = run(cmd, Limits(args.time, args.memory, args.output, processes=args.processes),
             writable=[folder], isolate=not args.no_isolation, keep=int(args.output * (1 << 20)),
-            user=user)
+            user=user, readable=[program] if program and os.path.isfile(program) else [])
     for name, data in (("stdout.txt", r.stdout), ("stderr.txt", r.stderr)):
         with open(os.path.join(folder, name), "wb") as f:
             f.write(data)

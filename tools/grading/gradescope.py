@@ -44,8 +44,10 @@ import zipfile
 
 from . import ROOT, sandbox
 from .strict_numbers import MAX_SECONDS, decimal, step_list
+from .errors import NOT_GRADED_EXIT
 from .exercises import exercises
 from .grade_class import run_grader
+from .grade_report import one_line
 from .kit import tracked_files
 from .submissions import ARCHIVE_SUFFIXES, SubmissionError, read_submission, stage
 
@@ -318,9 +320,9 @@ def grade_submission(args, started, write):
     try:
         files = submission_files(os.path.join(args.root, "submission"))
     except (SubmissionError, OSError) as e:
-        write(failure(f"The submission cannot be graded: {e}. Submit your workbook tree (the folder "
-                      "with steps/) or a zip of it."))
-        print(f"[gradescope] not graded: {e}", file=sys.stderr)
+        write(failure(f"The submission cannot be graded: {one_line(e)}. Submit your workbook tree (the "
+                      "folder with steps/) or a zip of it."))
+        print(f"[gradescope] not graded: {one_line(e)}", file=sys.stderr)
         return 0
     limit = float(config.get("limit", DEFAULT_LIMIT))
     with tempfile.TemporaryDirectory(prefix="boxes-submission-") as tmp:
@@ -339,6 +341,11 @@ def grade_submission(args, started, write):
     if graded.code is None:
         write(failure(f"The grading ran past its time limit of {limit:g} s before any exercise was "
                       "graded: zero points. Your instructor sees its log."))
+        return 0
+    if graded.code == NOT_GRADED_EXIT:
+        write(failure(f"Not graded: {graded.last_line[len('not graded: '):]}. A problem of the "
+                      "autograder's machine, not a verdict on your code: submit again."))
+        print(f"[gradescope] {graded.last_line}", file=sys.stderr)
         return 0
     if graded.code != 0:
         write(failure(GRADER_FAILED))

@@ -219,6 +219,7 @@ def _grade_one(sub, workers, opts, result):
         result.update(status="graded", rows=rows,
                       build="ok" if not broken else "step " + ",".join(broken) + " does not compile")
     result["total"] = sum(r["points"] for r in result["rows"])
+    os.makedirs(report, exist_ok=True)
     with open(os.path.join(report, "result.json"), "w") as f:
         json.dump(result, f, indent=1)
     return result

@@ -2,9 +2,10 @@
 # Runs one untrusted command isolated and limited (for the grader: student builds and tests).
 # usage: tools/grading/sandbox.sh [--time SECONDS] [--memory MB] [--output MB] [--processes N]
 #                                 [--dir DIR] [--no-isolation [--user NAME]] -- COMMAND [ARGS...]
-# Isolation (bubblewrap): the whole system read-only, DIR (default: a fresh folder in the
-# clone's build/sandbox/) the only writable place and the working directory, a private /tmp, no network,
-# own PID and user namespace without capabilities, killed with this script. Limits:
+# Isolation (bubblewrap): of the machine only the system read-only (/usr, /etc), DIR (default: a
+# fresh folder in the clone's build/sandbox/) the only writable place and the working directory,
+# the command's program, a private /tmp and /dev/shm, no network, own PID namespace without
+# capabilities (as root: a user id of its own), killed with this script. Limits:
 # wall-clock seconds, CPU seconds, address space, output and the size of any file written.
 # The command's stdout and stderr go to DIR/stdout.txt and DIR/stderr.txt (bounded by the
 # output limit). Prints one line "sandbox: RESULT" on stdout: ok | failed: exit N |

@@ -47,6 +47,7 @@ from tools.grading.exercises import exercises, step_sources  # noqa: E402
 from tools.grading.grade import solution_files  # noqa: E402
 from tools.grading.kit import CLASSROOM_WORKFLOW, write_kit  # noqa: E402
 from tools.grading.sandbox import isolation_problem  # noqa: E402
+from tools.grading.users import processes_of  # noqa: E402
 
 SKIPPED = 77  # ctest's SKIP_RETURN_CODE
 
@@ -294,17 +295,7 @@ def user_processes(name):
         uid = int(subprocess.run(["id", "-u", name], capture_output=True, text=True, check=True).stdout)
     except (subprocess.CalledProcessError, ValueError):
         return []
-    found = []
-    for entry in os.listdir("/proc"):
-        if entry.isdigit():
-            try:
-                with open(f"/proc/{entry}/status") as f:
-                    fields = dict(line.split(":", 1) for line in f if ":" in line)
-                if uid in map(int, fields["Uid"].split()[:2]) and fields["State"].split()[0] not in "ZX":
-                    found.append(int(entry))
-            except (OSError, KeyError, ValueError):
-                pass
-    return found
+    return [pid for pid, _ in processes_of(uid)]
 
 
 def layout_root(work):

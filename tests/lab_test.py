@@ -31,6 +31,7 @@ import time
 ROOT = os.path.dirname(os.path.dirname(os.path.abspath(__file__)))
 sys.path.insert(0, ROOT)
 from tools.grading.kit import tracked_files  # noqa: E402
+from tools.grading.users import processes_of  # noqa: E402
 
 SKIPPED = 77
 STEP = "01"
@@ -78,26 +79,12 @@ def user_names(work):
     return [f"boxes-lab{tag}{c}" for c in "ab"]
 
 
-def processes_of(uid):
-    found = []
-    for entry in os.listdir("/proc"):
-        if entry.isdigit():
-            try:
-                with open(f"/proc/{entry}/status") as f:
-                    fields = dict(line.split(":", 1) for line in f if ":" in line)
-                if uid in map(int, fields["Uid"].split()[:2]) and fields["State"].split()[0] not in "ZX":
-                    found.append(int(entry))
-            except (OSError, KeyError, ValueError):
-                pass
-    return found
-
-
 def remove_user(name):
     try:
         uid = pwd.getpwnam(name).pw_uid
     except KeyError:
         return
-    for pid in processes_of(uid):
+    for pid, _ in processes_of(uid):
         try:
             os.kill(pid, signal.SIGKILL)
         except ProcessLookupError:

@@ -11,7 +11,7 @@ from unittest import mock
 import scratch  # noqa: F401  (tempfile's folders: one, removed at exit)
 
 sys.path.insert(0, os.path.dirname(os.path.dirname(os.path.dirname(os.path.abspath(__file__)))))
-from tools.grading import sandbox  # noqa: E402
+from tools.grading import bubblewrap, cgroups, sandbox, users  # noqa: E402
 from tools.grading.sandbox import Limits, _classify  # noqa: E402
 
 
@@ -65,12 +65,12 @@ class BubblewrapPrefix(unittest.TestCase):
         home = os.path.expanduser("~")
         work = os.path.join(home, "boxes-test-no-such-folder", "w0", "build")
         data = "/usr/share/doc"  # a folder the test program reads, inside the system
-        prefix = sandbox.bwrap_prefix([work], work, 1 << 20, hidden=[home, "/usr/share"],
+        prefix = bubblewrap.bwrap_prefix([work], work, 1 << 20, hidden=[home, "/usr/share"],
                                       readable=[data])
         text = " ".join(prefix)
         bound = {dest for option, dest in mounts(prefix) if option in ("--ro-bind", "--bind")}
-        self.assertEqual(bound, set(sandbox.SYSTEM_DIRS) | {work, data} |
-                         {d for d in sandbox.SYSTEM_LINKS if os.path.isdir(d) and not os.path.islink(d)})
+        self.assertEqual(bound, set(bubblewrap.SYSTEM_DIRS) | {work, data} |
+                         {d for d in bubblewrap.SYSTEM_LINKS if os.path.isdir(d) and not os.path.islink(d)})
         self.assertNotIn("--ro-bind / /", text)  # not the whole machine, covered in places
         self.assertNotIn(f"--tmpfs {home}", text)  # absent, nothing to cover
         self.assertIn(f"--bind {work} {work}", text)
@@ -89,7 +89,7 @@ class BubblewrapPrefix(unittest.TestCase):
 
     def test_a_scratch_folder_is_a_sized_tmpfs_with_its_outputs_bound(self):
         scratch, result = "/w/case", "/w/case/result.xml"
-        prefix = sandbox.bwrap_prefix([], scratch, 1 << 20, scratch=scratch, scratch_bytes=3 << 20,
+        prefix = bubblewrap.bwrap_prefix([], scratch, 1 << 20, scratch=scratch, scratch_bytes=3 << 20,
                                       outputs=[result])
         text = " ".join(prefix)
         self.assertIn(f"--size {3 << 20} --perms 1777 --tmpfs {scratch}", text)
@@ -98,15 +98,15 @@ class BubblewrapPrefix(unittest.TestCase):
         self.assertNotIn(f"--bind {scratch} ", text)  # nothing of the host folder but the result
 
     def test_as_root_the_command_becomes_a_user_of_its_own(self):
-        user = sandbox.User("uid 2130706500", 2130706500, 2130706500)
-        prefix = sandbox.bwrap_prefix(["/w"], "/w", 1 << 20, user=user)
+        user = users.User("uid 2130706500", 2130706500, 2130706500)
+        prefix = bubblewrap.bwrap_prefix(["/w"], "/w", 1 << 20, user=user)
         self.assertNotIn("--unshare-user", prefix)  # its id outside is the user's, not root's
         self.assertNotIn("--unshare-all", prefix)
         for flag in ("--unshare-pid", "--unshare-net", "--unshare-ipc", "--die-with-parent"):
             self.assertIn(flag, prefix)
         kept = [prefix[i + 1] for i, a in enumerate(prefix) if a == "--cap-add"]
         self.assertEqual(set(kept), {"CAP_SETUID", "CAP_SETGID", "CAP_SETPCAP", "CAP_DAC_OVERRIDE"})
-        become = sandbox.become(user)
+        become = bubblewrap.become(user)
         self.assertTrue(become[0].endswith("setpriv"))
         for flag in ("--reuid=2130706500", "--regid=2130706500", "--clear-groups", "--inh-caps=-all",
                      "--bounding-set=-all", "--no-new-privs"):
@@ -115,8 +115,8 @@ class BubblewrapPrefix(unittest.TestCase):
 
 class OlderBubblewrap(unittest.TestCase):
     def test_options_it_lacks_are_left_out(self):
-        with mock.patch.object(sandbox, "bwrap_has", lambda option: False):  # Ubuntu 22.04's 0.6
-            prefix = sandbox.bwrap_prefix(["/w"], "/w", 1 << 20)
+        with mock.patch.object(bubblewrap, "bwrap_has", lambda option: False):  # Ubuntu 22.04's 0.6
+            prefix = bubblewrap.bwrap_prefix(["/w"], "/w", 1 << 20)
         self.assertNotIn("--disable-userns", prefix)
         self.assertNotIn("--size", prefix)
         self.assertIn("--unshare-user", prefix)
@@ -139,28 +139,28 @@ class CpuQuota(unittest.TestCase):
     def test_cgroup_v2_in_a_container_and_on_a_host(self):
         # A container's namespace shows its cgroup as /: the quota is at the mount's root.
         args = self.layout("0::/\n", "cgroup2 ROOT/fs cgroup2 rw 0 0\n", {"fs/cpu.max": "50000 100000\n"})
-        self.assertEqual(sandbox.cgroup_cpu_quota(*args), 0.5)
+        self.assertEqual(cgroups.cgroup_cpu_quota(*args), 0.5)
         # On a host: the tightest of the cgroup and its parents.
         args = self.layout("0::/a/b\n", "cgroup2 ROOT/fs cgroup2 rw 0 0\n",
                            {"fs/cpu.max": "max 100000\n", "fs/a/cpu.max": "150000 100000\n",
                             "fs/a/b/cpu.max": "max 100000\n"})
-        self.assertEqual(sandbox.cgroup_cpu_quota(*args), 1.5)
+        self.assertEqual(cgroups.cgroup_cpu_quota(*args), 1.5)
 
     def test_cgroup_v1_and_none(self):
         args = self.layout("4:cpu,cpuacct:/docker/abc\n", "cgroup ROOT/cpu cgroup rw,cpu,cpuacct 0 0\n",
                            {"cpu/cpu.cfs_quota_us": "200000\n", "cpu/cpu.cfs_period_us": "100000\n"})
-        self.assertEqual(sandbox.cgroup_cpu_quota(*args), 2.0)  # the path is not there: the mount's root
+        self.assertEqual(cgroups.cgroup_cpu_quota(*args), 2.0)  # the path is not there: the mount's root
         args = self.layout("4:cpu,cpuacct:/\n", "cgroup ROOT/cpu cgroup rw,cpu,cpuacct 0 0\n",
                            {"cpu/cpu.cfs_quota_us": "-1\n", "cpu/cpu.cfs_period_us": "100000\n"})
-        self.assertIsNone(sandbox.cgroup_cpu_quota(*args))
+        self.assertIsNone(cgroups.cgroup_cpu_quota(*args))
 
     def test_usable_cpus(self):
-        self.assertTrue(1 <= sandbox.usable_cpus() <= (os.cpu_count() or 1))
+        self.assertTrue(1 <= cgroups.usable_cpus() <= (os.cpu_count() or 1))
 
 
 class LimitsAndRuns(unittest.TestCase):
     def test_cpu_seconds_cover_every_core(self):
-        self.assertEqual(Limits(seconds=10).cpu_seconds(), 10 * sandbox.usable_cpus() + 1)
+        self.assertEqual(Limits(seconds=10).cpu_seconds(), 10 * cgroups.usable_cpus() + 1)
 
     def test_a_run_without_isolation(self):
         r = sandbox.run(["sh", "-c", "echo hi; echo oops >&2; exit 4"], Limits(seconds=10), isolate=False)

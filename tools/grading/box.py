@@ -13,6 +13,7 @@ from dataclasses import dataclass
 from . import sandbox
 from .errors import GradeError, NotGraded, OutOfTime
 from .grade_report import printable, say
+from .users import USER_PYTHON, User
 
 
 @dataclass
@@ -29,10 +30,10 @@ class Isolation:
     deadline: float = None  # time.monotonic() by which the whole grading ends (None: none)
     log: object = None  # where progress goes (None: stderr)
     # Without isolation, as root: the unprivileged user student code runs as (a
-    # sandbox.User). The grading tree is then readable to it, the build folder its own only
+    # users.User). The grading tree is then readable to it, the build folder its own only
     # while it builds, each test case's folder its own; the rest is the grader's. (Isolated,
     # as root, each command runs as a user id of its own: sandbox.run picks it.)
-    user: sandbox.User = None
+    user: User = None
     disk: str = None  # the grading folder, whose disk a failed command may have found full
 
     @property
@@ -63,7 +64,7 @@ def check_user_access(iso, work, secret):
     with tempfile.TemporaryDirectory(prefix="probe-", dir=work) as folder:
         os.chmod(folder, 0o711)
         os.chown(folder, iso.user.uid, iso.user.gid)
-        r = sandbox.run([sandbox.USER_PYTHON, "-I", "-S", "-c", _ACCESS_PROBE] + paths,
+        r = sandbox.run([USER_PYTHON, "-I", "-S", "-c", _ACCESS_PROBE] + paths,
                         sandbox.Limits(seconds=30, memory_mb=1024, output_mb=1), writable=[folder],
                         isolate=False, env=clean_env(folder), user=iso.user)
     try:

@@ -59,6 +59,7 @@ from .exercises import BEGIN, exercises, step_sources
 from .grade_report import exercise_row, print_table, printable, results_by_exercise, say, write_json, write_junit
 from .grading_tree import assemble, hidden_copies, share_tree
 from .strict_numbers import MAX_JOBS, MAX_MB, MAX_SECONDS, decimal, integer, step_list
+from .users import grading_user
 
 
 @dataclass
@@ -159,7 +160,7 @@ def grade(student, opts, out=None, log=None, deadline=None, partial=False):
         if os.geteuid() != 0:
             raise GradeError("grade: --user runs student code as another user: that needs root", 2)
         try:
-            user = sandbox.grading_user(opts.user)
+            user = grading_user(opts.user)
         except ValueError as e:
             raise GradeError(f"grade: --user: {e}", 2) from None
     elif opts.no_isolation and os.geteuid() == 0:

@@ -36,6 +36,7 @@ from concurrent.futures import ThreadPoolExecutor, as_completed
 
 from . import ROOT, sandbox
 from .strict_numbers import MAX_JOBS, MAX_SECONDS, decimal, integer, step_list
+from .cgroups import usable_cpus
 from .errors import NOT_GRADED_EXIT
 from .exercises import exercises
 from .grade import GradeOptions, grade_into
@@ -342,7 +343,7 @@ def grade_class(opts):
     opts.all_ex = {e.id: e for e in all_ex}
     opts.hidden = os.path.abspath(opts.hidden) if opts.hidden else None
     opts.jobs = max(1, opts.jobs)
-    opts.compile_jobs = max(1, sandbox.usable_cpus() // opts.jobs)
+    opts.compile_jobs = max(1, usable_cpus() // opts.jobs)
     key = config_hash(opts.hidden, opts.steps, opts.timeout)
 
     subs = discover(opts.submissions)
@@ -441,7 +442,7 @@ def main(argv):
     p.add_argument("submissions", help="folder with one folder, git repository or archive per student")
     p.add_argument("--out", default=os.path.join(ROOT, "build", "class-grades"),
                    help="where the results go (default build/class-grades)")
-    p.add_argument("--jobs", type=integer(1, MAX_JOBS), default=sandbox.usable_cpus(),
+    p.add_argument("--jobs", type=integer(1, MAX_JOBS), default=usable_cpus(),
                    help="students graded at once (default: the cores this process may use)")
     p.add_argument("--hidden", help="folder of extra doctest files stepNN*.cpp (as for grade)")
     p.add_argument("--steps", type=step_list, help="grade only these steps, e.g. 01,03")

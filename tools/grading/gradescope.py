@@ -44,6 +44,7 @@ import zipfile
 
 from . import ROOT, sandbox
 from .strict_numbers import MAX_SECONDS, decimal, step_list
+from .cgroups import usable_cpus
 from .errors import NOT_GRADED_EXIT
 from .exercises import exercises
 from .grade_class import run_grader
@@ -210,7 +211,7 @@ def prime(args):
     user = student_user(config, isolated)
     report = os.path.join(work, "reference")
     r = run_grader(ROOT, work, report, config["steps"], hidden, config["timeout"],
-                   sandbox.usable_cpus(), not isolated, user=user)
+                   usable_cpus(), not isolated, user=user)
     os.chmod(report, 0o700)
     rows = r.results
     missing = [x["exercise"] for x in rows if not x["passed"]]
@@ -221,7 +222,7 @@ def prime(args):
               f"see {report}", file=sys.stderr)
         return 1
     how = "in bubblewrap" if isolated else (f"as user {user}" if user else "without isolation")
-    print(f"[gradescope] grading build primed in {r.seconds:.0f} s ({sandbox.usable_cpus()} CPUs, "
+    print(f"[gradescope] grading build primed in {r.seconds:.0f} s ({usable_cpus()} CPUs, "
           f"student code {how}): the reference gets full points", file=sys.stderr)
     return 0
 
@@ -330,7 +331,7 @@ def grade_submission(args, started, write):
         report = os.path.join(tmp, "report")
         isolated = isolation()
         graded = run_grader(tree, work, report, config["steps"], hidden, config["timeout"],
-                            sandbox.usable_cpus(), not isolated, user=student_user(config, isolated),
+                            usable_cpus(), not isolated, user=student_user(config, isolated),
                             limit=max(1.0, limit - (time.monotonic() - started)), partial=True)
         with open(os.path.join(report, "points.txt"), errors="replace") as f:
             table = f.read()

@@ -14,6 +14,9 @@
 # --user NAME (with --no-isolation, as root): the command runs as that unprivileged user,
 # and every process of that user is killed when it ends.
 # The one implementation is sandbox.py beside this (the grader imports it); this is its
-# wrapper. sandbox.py imports nothing of the workbook, so it runs as a script from the
-# caller's folder (DIR and the command's paths are the caller's).
-exec /usr/bin/python3 "$(dirname "$0")/sandbox.py" "$@"
+# wrapper. It runs in the caller's folder (DIR and the command's paths are the caller's), so
+# the tools package is put on Python's path here, and only it (-I: not the caller's folder).
+tree=$(cd "$(dirname "$0")/../.." && pwd)
+exec /usr/bin/python3 -I -c 'import sys; sys.path.insert(0, sys.argv.pop(1))
+from tools.grading.sandbox import main
+sys.exit(main(sys.argv[1:]))' "$tree" "$@"

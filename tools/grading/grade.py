@@ -198,8 +198,22 @@ def _grade(student_path, opts, out, log, partial, work, all_ex, steps, hidden, i
         notes.append(f"student code ran without isolation, as user {iso.user.name}")
     elif not iso.isolate:
         notes.append("student code ran without isolation (--no-isolation)")
-    configure(work, iso)
     rows = []
+
+    def out_of_time(k, what):
+        # With `partial`, the exercises not graded in time fail with that reason.
+        if not partial:
+            raise OutOfTime()
+        why = ("time limit", "not graded: the grading ran past its overall time limit")
+        for later in steps[k:]:
+            rows.extend(exercise_row(e, later, why, [], 0.0) for e in all_ex if f"{e.step:02d}" == later)
+        say(f"out of time {what}: its exercises and the later ones are not graded", log)
+
+    try:
+        configure(work, iso)
+    except OutOfTime:
+        out_of_time(0, "while configuring")
+        steps = []
     # The test cases' folders: in WORK (the clone's build/ by default), not the shared /tmp,
     # and removed when grading ends, however it ends.
     with tempfile.TemporaryDirectory(prefix="scratch-", dir=work, ignore_cleanup_errors=True) as scratch:
@@ -212,12 +226,7 @@ def _grade(student_path, opts, out, log, partial, work, all_ex, steps, hidden, i
             try:
                 step_rows = grade_step(work, number, items, iso, scratch, notes, log, t0)
             except OutOfTime:
-                if not partial:
-                    raise
-                why = ("time limit", "not graded: the grading ran past its overall time limit")
-                for later in steps[k:]:
-                    rows += [exercise_row(e, later, why, [], 0.0) for e in all_ex if f"{e.step:02d}" == later]
-                say(f"out of time at step {number}: its exercises and the later ones are not graded", log)
+                out_of_time(k, f"at step {number}")
                 break
             rows += step_rows
     notes = [printable(n) for n in notes]

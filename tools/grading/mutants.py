@@ -17,7 +17,8 @@ usage: ./workbook mutants [N.M | NN | N.M-name ...] [--list] [--check]
   --list   the catalogue
   --check  only check the catalogue: every patch applies, names its case, has a hint
   --safeguards  the hard cases' safeguards removed instead (tests/safeguards,
-           tools/grading/safeguards.py): exactly the named hard cases must fail
+           tools/grading/safeguards.py, which ./workbook runs for it): exactly the named
+           hard cases must fail
 
 Each mutant is applied to a private copy of the tree (build/mutants/tree, kept between
 runs so that its build is incremental), the exercise's test program alone is built, the
@@ -314,12 +315,13 @@ def private_tree():
 
 
 def main(argv):
-    if "--safeguards" in argv:
-        from . import safeguards
-        return safeguards.main(argv)
     args = [a for a in argv if not a.startswith("-")]
     flags = [a for a in argv if a.startswith("-")]
     for f in flags:
+        if f == "--safeguards":
+            print("mutants: the safeguards are python3 -m tools.grading.safeguards (./workbook mutants "
+                  "--safeguards runs it)", file=sys.stderr)
+            return 2
         if f not in ("--list", "--check", "-h", "--help"):
             print(f"mutants: unknown option '{f}' (use: mutants [N.M ...] [--list] [--check])",
                   file=sys.stderr)

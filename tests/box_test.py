@@ -2,7 +2,7 @@
 """Hostile submissions against the grader's box (ctest label "grading"): what grading reads of
 a student's tree, what a student's test sees and fills, what one bad submission costs.
 
-usage: tests/box_test.py SCENARIO WORK_DIR
+usage: python3 -m tests.box_test SCENARIO WORK_DIR
   links       grade TREE on trees with links in steps/: the reference's solutions through
               /proc/self/cwd, /etc/shadow, a root-only file, /dev/zero, a FIFO, a linked
               folder. The grader reads none of them (each is named with its reason), never
@@ -38,8 +38,8 @@ import tempfile
 import time
 import zipfile
 
-from class_grading_test import (HOSTILE_HEADERS, ROOT, SKIPPED, TIMEOUT, check, exercises, failures,
-                                first_step, isolation_works, no_isolation, step_ids, table, tool)
+from tests.class_grading_test import (HOSTILE_HEADERS, ROOT, SKIPPED, TIMEOUT, check, exercises, failures,
+                                      first_step, isolation_works, no_isolation, step_ids, table, tool)
 from tools.grading.class_bench import student_sources
 from tools.grading.submissions import MAX_MEMBERS
 
@@ -365,7 +365,7 @@ def main():
         print(__doc__, file=sys.stderr)
         return 2
     if not os.path.isdir(os.path.join(work, "workers", "w0", "build")):
-        print(f"{work}/workers is not primed: run tests/class_grading_test.py class {work} first")
+        print(f"{work}/workers is not primed: run python3 -m tests.class_grading_test class {work} first")
         return 1
     started = time.monotonic()
     if scenarios[scenario](work) == SKIPPED:

@@ -1,7 +1,7 @@
 #!/usr/bin/python3
 """End-to-end tests of grading a class and of the platforms (ctest label "grading").
 
-usage: tests/class_grading_test.py SCENARIO WORK_DIR
+usage: python3 -m tests.class_grading_test SCENARIO WORK_DIR
   class       a generated class of 6 (the first step with exercises only) graded with 2 jobs,
               stopped after the first results and resumed, scores exactly the expected points;
               a third run keeps every result, and a changed submission alone is graded again
@@ -39,15 +39,14 @@ import time
 import xml.etree.ElementTree as ET
 import zipfile
 
-ROOT = os.path.dirname(os.path.dirname(os.path.abspath(__file__)))
-sys.path.insert(0, ROOT)  # the tools package, imported from the repository root
-from tools.grading.class_bench import check as check_expected, make_class, student_sources  # noqa: E402
-from tools.grading.classroom import CLASSROOM_STEP_TIMEOUT, exercise_command, step_id  # noqa: E402
-from tools.grading.exercises import exercises, step_sources  # noqa: E402
-from tools.grading.grade import solution_files  # noqa: E402
-from tools.grading.kit import CLASSROOM_WORKFLOW, write_kit  # noqa: E402
-from tools.grading.sandbox import isolation_problem  # noqa: E402
-from tools.grading.users import processes_of  # noqa: E402
+from tools import ROOT
+from tools.grading.class_bench import check as check_expected, make_class, student_sources
+from tools.grading.classroom import CLASSROOM_STEP_TIMEOUT, exercise_command, step_id
+from tools.grading.exercises import exercises, step_sources
+from tools.grading.grade import solution_files
+from tools.grading.kit import CLASSROOM_WORKFLOW, write_kit
+from tools.grading.sandbox import isolation_problem
+from tools.grading.users import processes_of
 
 SKIPPED = 77  # ctest's SKIP_RETURN_CODE
 

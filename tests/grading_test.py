@@ -1,7 +1,7 @@
 #!/usr/bin/python3
 """End-to-end tests of the starter kit and of grading (ctest label "grading").
 
-usage: tests/grading_test.py SCENARIO WORK_DIR
+usage: python3 -m tests.grading_test SCENARIO WORK_DIR
   kit            the kit has no solution line left, a stub per exercise, everything else equal
   reference      the reference tree scores full points
   kit-zero       the starter kit scores zero, each failure naming its exercise
@@ -38,11 +38,10 @@ import tempfile
 import time
 import xml.etree.ElementTree as ET
 
-ROOT = os.path.dirname(os.path.dirname(os.path.abspath(__file__)))
-sys.path.insert(0, ROOT)  # the tools package, imported from the repository root
-from tools.grading.exercises import BEGIN, END, exercises, step_sources  # noqa: E402
-from tools.grading.kit import NOT_IN_KIT, strip_solutions, write_kit  # noqa: E402
-from tools.grading.sandbox import isolation_problem  # noqa: E402
+from tools import ROOT
+from tools.grading.exercises import BEGIN, END, exercises, step_sources
+from tools.grading.kit import NOT_IN_KIT, strip_solutions, write_kit
+from tools.grading.sandbox import isolation_problem
 
 # The grader as ./workbook grade runs it: a module of the tools package, from the root.
 GRADE = [sys.executable, "-m", "tools.grading.grade"]

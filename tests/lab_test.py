@@ -2,7 +2,7 @@
 """The computer lab (ctest label "lab"): packages installed once by an administrator, every
 student an ordinary user with a clone of their own.
 
-usage: tests/lab_test.py WORK_DIR   (as root: it creates two users; skipped, 77, otherwise)
+usage: python3 -m tests.lab_test WORK_DIR   (as root: it creates two users; skipped, 77, otherwise)
 
 As root, with a root-owned file already at every fixed /tmp path the workbook once used
 (FIXED_PATHS), it creates two unprivileged users, gives each a fresh clone of this tree in
@@ -28,10 +28,9 @@ import sys
 import threading
 import time
 
-ROOT = os.path.dirname(os.path.dirname(os.path.abspath(__file__)))
-sys.path.insert(0, ROOT)
-from tools.grading.kit import tracked_files  # noqa: E402
-from tools.grading.users import processes_of  # noqa: E402
+from tools import ROOT
+from tools.grading.kit import tracked_files
+from tools.grading.users import processes_of
 
 SKIPPED = 77
 STEP = "01"

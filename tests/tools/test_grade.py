@@ -5,21 +5,18 @@ import contextlib
 import io
 import json
 import os
-import sys
 import tempfile
 import time
 import unittest
 import xml.etree.ElementTree as ET
-import scratch  # noqa: F401  (tempfile's folders: one, removed at exit)
+from tests.tools import scratch  # noqa: F401  (tempfile's folders: one, removed at exit)
 
-sys.path.insert(0, os.path.dirname(os.path.dirname(os.path.dirname(os.path.abspath(__file__)))))
-from tools.grading import (box, build_and_run, class_bench, errors, grade, grade_class, grade_report,  # noqa: E402
+from tools.grading import (box, build_and_run, class_bench, errors, grade, grade_class, grade_report,
                            gradescope, grading_tree, sandbox)
-sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
-import test_strict_numbers  # noqa: E402
-from tools.grading.exercises import CaseResult, Exercise, exercises  # noqa: E402
-from tools.grading.build_and_run import CaseOutcome, case_outcome  # noqa: E402
-from tools.grading.grade_report import exercise_row  # noqa: E402
+from tests.tools import test_strict_numbers
+from tools.grading.exercises import CaseResult, Exercise, exercises
+from tools.grading.build_and_run import CaseOutcome, case_outcome
+from tools.grading.grade_report import exercise_row
 
 
 def first_step():

@@ -4,18 +4,16 @@ import contextlib
 import csv
 import io
 import os
-import sys
 import tempfile
 import types
 import unittest
 import zipfile
 from unittest import mock
-import scratch  # noqa: F401  (tempfile's folders: one, removed at exit)
+from tests.tools import scratch  # noqa: F401  (tempfile's folders: one, removed at exit)
 
-sys.path.insert(0, os.path.dirname(os.path.dirname(os.path.dirname(os.path.abspath(__file__)))))
-from tools.grading import grade, grade_class  # noqa: E402
-from tools.grading.errors import NOT_GRADED_EXIT  # noqa: E402
-from tools.grading.exercises import Exercise  # noqa: E402
+from tools.grading import grade, grade_class
+from tools.grading.errors import NOT_GRADED_EXIT
+from tools.grading.exercises import Exercise
 
 EXERCISES = [Exercise("1.1", "a sum", 1, "x"), Exercise("1.2", "a root", 2, "x")]
 

@@ -1,13 +1,11 @@
 """Unit tests of tools/grading/kit.py: stripping the solutions from a source."""
 import os
-import sys
 import tempfile
 import unittest
-import scratch  # noqa: F401  (tempfile's folders: one, removed at exit)
+from tests.tools import scratch  # noqa: F401  (tempfile's folders: one, removed at exit)
 
-sys.path.insert(0, os.path.dirname(os.path.dirname(os.path.dirname(os.path.abspath(__file__)))))
-from tools.grading import kit  # noqa: E402
-from tools.grading.kit import check_no_solution_left, strip_solutions  # noqa: E402
+from tools.grading import kit
+from tools.grading.kit import check_no_solution_left, strip_solutions
 
 SOURCE = """#include "steps/01_x/x.hpp"
 #include <cmath>

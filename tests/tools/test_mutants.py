@@ -6,14 +6,11 @@ test cases that exist. The slow runs themselves are the ctest label mutants and
 ./workbook mutants --safeguards."""
 import json
 import os
-import subprocess
-import sys
 import tempfile
 import unittest
 
-ROOT = os.path.dirname(os.path.dirname(os.path.dirname(os.path.abspath(__file__))))
-sys.path.insert(0, ROOT)
-from tools.grading import mutants, safeguards  # noqa: E402
+from tools import ROOT
+from tools.grading import mutants, safeguards
 
 PATCH = """Mistake: a + b written a - b
 Caught by: sum: worked values

@@ -2,17 +2,15 @@
 bubblewrap command line, the limits, and stopping every run."""
 import os
 import signal
-import sys
 import tempfile
 import threading
 import time
 import unittest
 from unittest import mock
-import scratch  # noqa: F401  (tempfile's folders: one, removed at exit)
+from tests.tools import scratch  # noqa: F401  (tempfile's folders: one, removed at exit)
 
-sys.path.insert(0, os.path.dirname(os.path.dirname(os.path.dirname(os.path.abspath(__file__)))))
-from tools.grading import bubblewrap, cgroups, sandbox, users  # noqa: E402
-from tools.grading.sandbox import Limits, _classify  # noqa: E402
+from tools.grading import bubblewrap, cgroups, sandbox, users
+from tools.grading.sandbox import Limits, _classify
 
 
 def reason(code, stopped="", isolate=True, out=b"", err=b""):

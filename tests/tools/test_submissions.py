@@ -4,17 +4,15 @@ import io
 import os
 import stat
 import struct
-import sys
 import tarfile
 import tempfile
 import unittest
 import zipfile
 from unittest import mock
-import scratch  # noqa: F401  (tempfile's folders: one, removed at exit)
+from tests.tools import scratch  # noqa: F401  (tempfile's folders: one, removed at exit)
 
-sys.path.insert(0, os.path.dirname(os.path.dirname(os.path.dirname(os.path.abspath(__file__)))))
-from tools.grading import submissions  # noqa: E402
-from tools.grading.submissions import (SubmissionError, _step_relpath, content_hash, is_submission,  # noqa: E402
+from tools.grading import submissions
+from tools.grading.submissions import (SubmissionError, _step_relpath, content_hash, is_submission,
                                        read_submission, stage, student_name)
 
 

@@ -404,7 +404,7 @@ HOSTILE = {
     "loop": ("time limit", "time limit", ["--timeout", "4"]),
     "segv": ("crashed", "crashed: SIGSEGV", []),
     "memory": ("memory limit", "memory limit", ["--memory", "320"]),
-    "files": ("failed", "Read-only file system", []),
+    "files": ("failed", "failed: threw: ", []),  # each path refused: see scenario_hostile
     "read": ("failed", "cannot read", []),
     "network": ("failed", "connect: ", []),
     "output": ("output limit", "output limit", ["--output", "4"]),
@@ -481,6 +481,12 @@ def scenario_hostile(work, kind):
                   f"{kind}: {p} is not there for the student's code")
     if kind == "files":
         check("wrote /tmp/" in got.get("reason", ""), f"{kind}: the private /tmp was writable (and is gone)")
+        # Every other place refused the write with its error (not there, not the sandbox's
+        # user's, or read-only): none of them was written.
+        for p in hostile_paths(token, work):
+            if not p.startswith("/tmp/"):
+                check(f"{p}: " in got.get("reason", "") and f"wrote {p}" not in got.get("reason", ""),
+                      f"{kind}: writing {p} was refused")
     try:
         connection, _ = listener.accept()
         connection.close()

@@ -41,16 +41,7 @@ import zipfile
 from tests.class_grading_test import (HOSTILE_HEADERS, ROOT, SKIPPED, TIMEOUT, check, exercises, failures,
                                       first_step, isolation_works, no_isolation, step_ids, table, tool)
 from tools.grading.class_bench import student_sources
-from tools.grading.submissions import MAX_MEMBERS
-
-
-def write_tree(dest, files):
-    for rel, text in files.items():
-        path = os.path.join(dest, rel)
-        os.makedirs(os.path.dirname(path), exist_ok=True)
-        with open(path, "w", encoding="utf-8") as f:
-            f.write(text)
-    return dest
+from tools.grading.submissions import MAX_MEMBERS, write_files
 
 
 def step_files(solved):
@@ -109,7 +100,7 @@ def scenario_links(work):
                 continue
             # A tree whose exercise file links to the reference's solution: it is not read, so
             # the exercises are the kit's stubs (before: full points).
-            tree = write_tree(os.path.join(base, "solutions"), step_files([]))
+            tree = write_files(os.path.join(base, "solutions"), step_files([]))
             os.remove(os.path.join(tree, target.path))
             os.symlink(f"/proc/self/cwd/{target.path}", os.path.join(tree, target.path))
             r, doc = grade_json(tree, w0, extra)
@@ -120,7 +111,7 @@ def scenario_links(work):
                   f"links, {how}: a note names the link and why it was not read: {doc.get('notes')}")
             # A solved tree with hostile links and special files beside its regular sources:
             # the regular ones earn their points, the grader neither reads nor hangs on the rest.
-            tree = write_tree(os.path.join(base, "mixed"), step_files(ids))
+            tree = write_files(os.path.join(base, "mixed"), step_files(ids))
             specials = {"shadow.hpp": "/etc/shadow", "secret.hpp": secret, "zero.hpp": "/dev/zero",
                         "root": "/"}
             for name, to in specials.items():
@@ -192,10 +183,10 @@ def scenario_archives(work):
                  [(f"tree/{os.path.dirname(target)}/{'n' * 300}.cpp", "int n;")])
         tar_bomb(os.path.join(subs, "c-bomb.tar.gz"), kit)
         escapes = "d-\x1b]0;owned\x07\x1b[2J\x1b[31mred"
-        write_tree(os.path.join(subs, escapes), solved)
-        write_tree(os.path.join(subs, "e-new\nline"), kit)
-        write_tree(os.path.join(subs, "=HYPERLINK(\"x\")"), solved)
-        write_tree(os.path.join(subs, "f-reference"), solved)
+        write_files(os.path.join(subs, escapes), solved)
+        write_files(os.path.join(subs, "e-new\nline"), kit)
+        write_files(os.path.join(subs, "=HYPERLINK(\"x\")"), solved)
+        write_files(os.path.join(subs, "f-reference"), solved)
         started = time.monotonic()
         r, err = class_run(subs, out, os.path.join(work, "workers"))
         check(r.returncode == 0, f"archives: the class run finishes ({time.monotonic() - started:.0f} s)")
@@ -293,11 +284,11 @@ def scenario_neighbours(work):
         reader, hostile_id = hostile(reader_body(paths))
         filler, _ = hostile(filler_body([out, subs, os.path.join(workers, "w0", "build"),
                                          os.path.join(workers, "w1", "build")]))
-        write_tree(os.path.join(subs, "a-reader"), reader)
-        write_tree(os.path.join(subs, "b-filler"), filler)
-        write_tree(os.path.join(subs, "c-reference"), honest)
-        write_tree(os.path.join(subs, "d-kit"), step_files([]))
-        write_tree(os.path.join(subs, "e-one"), step_files(ids[:1]))
+        write_files(os.path.join(subs, "a-reader"), reader)
+        write_files(os.path.join(subs, "b-filler"), filler)
+        write_files(os.path.join(subs, "c-reference"), honest)
+        write_files(os.path.join(subs, "d-kit"), step_files([]))
+        write_files(os.path.join(subs, "e-one"), step_files(ids[:1]))
         r, err = class_run(subs, out, workers)
         check(r.returncode == 0, "neighbours: the class run finishes")
         results = json.load(open(os.path.join(out, "cache.json")))["results"]
@@ -332,8 +323,8 @@ def scenario_disk_full(work):
     try:
         subs, out = os.path.join(base, "submissions"), os.path.join(base, "out")
         ids = step_ids()
-        write_tree(os.path.join(subs, "a-reference"), step_files(ids))
-        write_tree(os.path.join(subs, "b-kit"), step_files([]))
+        write_files(os.path.join(subs, "a-reference"), step_files(ids))
+        write_files(os.path.join(subs, "b-kit"), step_files([]))
         env = dict(os.environ, BOXES_GRADE_MIN_FREE_MB=str(1 << 40))  # more than any disk has
         r, err = class_run(subs, out, os.path.join(work, "workers"), env=env)
         check(r.returncode == 0, "disk-full: the class run finishes")

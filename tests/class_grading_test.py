@@ -46,6 +46,7 @@ from tools.grading.exercises import exercises, step_sources
 from tools.grading.grade import solution_files
 from tools.grading.kit import CLASSROOM_WORKFLOW, write_kit
 from tools.grading.sandbox import isolation_problem
+from tools.grading.submissions import write_files
 from tools.grading.users import processes_of
 
 SKIPPED = 77  # ctest's SKIP_RETURN_CODE
@@ -160,10 +161,7 @@ def scenario_class(work):
 def gradescope_run(work, root, files):
     sub = os.path.join(root, "submission")
     shutil.rmtree(sub, ignore_errors=True)
-    for rel, text in files.items():
-        os.makedirs(os.path.dirname(os.path.join(sub, rel)), exist_ok=True)
-        with open(os.path.join(sub, rel), "w", encoding="utf-8") as f:
-            f.write(text)
+    write_files(sub, files)
     results = os.path.join(root, "results", "results.json")
     if os.path.exists(results):
         os.remove(results)
@@ -420,10 +418,7 @@ def gradescope_root_run(work, files, label):
     root = layout_root(work)
     sub = os.path.join(root, "submission")
     shutil.rmtree(sub, ignore_errors=True)
-    for rel, text in files.items():
-        os.makedirs(os.path.dirname(os.path.join(sub, rel)), exist_ok=True)
-        with open(os.path.join(sub, rel), "w", encoding="utf-8") as f:
-            f.write(text)
+    write_files(sub, files)
     env = root_env(work, root)
     started = time.monotonic()
     r = subprocess.run([os.path.join(root, "run_autograder")], cwd=root, env=env, capture_output=True, text=True,
@@ -590,6 +585,8 @@ def scenario_gradescope_fork(work):
     how far it got."""
     if os.geteuid() != 0:
         return SKIPPED
+    # A C++ body as a list of lines, as the read scenario's: other code, the same shape (what
+    # the duplicates tool pairs them for).
     files, hostile = hostile_files(body=[
         "int forked = 0;",
         "for (;;) {",
@@ -629,10 +626,7 @@ def scenario_gradescope_control(work):
     root = layout_root(work)
     tree = os.path.join(work, "control-tree")
     shutil.rmtree(tree, ignore_errors=True)
-    for rel, text in files.items():
-        os.makedirs(os.path.dirname(os.path.join(tree, rel)), exist_ok=True)
-        with open(os.path.join(tree, rel), "w", encoding="utf-8") as f:
-            f.write(text)
+    write_files(tree, files)
     os.chmod(tree, 0o700)
     junit, js = os.path.join(work, "control.xml"), os.path.join(work, "control.json")
     env = root_env(work, root)

@@ -5,6 +5,7 @@ import unittest
 from tests.tools import scratch  # noqa: F401  (tempfile's folders: one, removed at exit)
 
 from tools.grading import kit
+from tools.grading.submissions import write_files
 from tools.grading.kit import check_no_solution_left, strip_solutions
 
 SOURCE = """#include "steps/01_x/x.hpp"
@@ -125,10 +126,7 @@ class KitContents(unittest.TestCase):
         files = {"steps/01_x/x.cpp": SOURCE, "tests/mutants/1.1-wrong-sum.patch":
                  "Mistake: a - b\nCaught by: sum\n\n-    float secret = a + b;\n+    float secret = a - b;\n",
                  "tests/hints/mistakes.json": "{}", "tools/grading/mutants.py": "# runner\n"}
-        for rel, text in files.items():
-            os.makedirs(os.path.dirname(os.path.join(root, rel)), exist_ok=True)
-            with open(os.path.join(root, rel), "w") as f:
-                f.write(text)
+        write_files(root, files)
         dest = os.path.join(tempfile.mkdtemp(), "kit")
         kit.write_kit(dest, root)
         written = kit.tracked_files(dest)

@@ -11,6 +11,7 @@ from tests.tools import scratch  # noqa: F401  (tempfile's folders: one, removed
 
 from tools.grading import bubblewrap, cgroups, sandbox, users
 from tools.grading.sandbox import Limits, _classify
+from tools.grading.submissions import write_files
 
 
 def reason(code, stopped="", isolate=True, out=b"", err=b""):
@@ -123,11 +124,7 @@ class OlderBubblewrap(unittest.TestCase):
 
 class CpuQuota(unittest.TestCase):
     def layout(self, cgroup_lines, mounts, files):
-        root = tempfile.mkdtemp()
-        for rel, text in files.items():
-            os.makedirs(os.path.dirname(os.path.join(root, rel)), exist_ok=True)
-            with open(os.path.join(root, rel), "w") as f:
-                f.write(text)
+        root = write_files(tempfile.mkdtemp(), files)
         with open(os.path.join(root, "cgroup"), "w") as f:
             f.write(cgroup_lines)
         with open(os.path.join(root, "mounts"), "w") as f:

@@ -385,16 +385,23 @@ def content_hash(files):
     return h.hexdigest()
 
 
-def stage(files, dest):
-    """Writes the sources into a fresh folder dest (a tree the grader can read)."""
-    if os.path.exists(dest):
-        shutil.rmtree(dest)
+def write_files(dest, files):
+    """Writes {relative path: bytes or text (UTF-8)} under the folder dest, making folders as
+    needed; a path that would land outside dest raises SubmissionError. Returns dest. (The
+    one "write these files into a tree" of the tools and their tests.)"""
     for rel, data in files.items():
         target = os.path.join(dest, rel)
-        # The relative paths come from _step_relpath (no '..', not absolute): stay inside.
         if not os.path.abspath(target).startswith(os.path.abspath(dest) + os.sep):
             raise SubmissionError(f"unsafe path {rel}")
         os.makedirs(os.path.dirname(target), exist_ok=True)
         with open(target, "wb") as f:
-            f.write(data)
+            f.write(data.encode() if isinstance(data, str) else data)
     return dest
+
+
+def stage(files, dest):
+    """Writes the sources into a fresh folder dest (a tree the grader can read). Their paths
+    come from _step_relpath (no '..', not absolute); write_files checks again."""
+    if os.path.exists(dest):
+        shutil.rmtree(dest)
+    return write_files(dest, files)

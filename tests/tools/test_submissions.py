@@ -269,6 +269,17 @@ class HashAndStage(unittest.TestCase):
             stage({"../escaped.cpp": b""}, dest)
         self.assertFalse(os.path.exists(os.path.join(os.path.dirname(dest), "escaped.cpp")))
 
+    def test_a_link_in_the_way_is_not_written_through(self):
+        dest, outside = tempfile.mkdtemp(), os.path.join(tempfile.mkdtemp(), "outside.cpp")
+        with open(outside, "w") as f:
+            f.write("untouched")
+        os.makedirs(os.path.join(dest, "steps"))
+        os.symlink(outside, os.path.join(dest, "steps", "x.cpp"))
+        with self.assertRaisesRegex(SubmissionError, "steps/x.cpp is a link"):
+            submissions.write_files(dest, {"steps/x.cpp": "int x;"})
+        with open(outside) as f:
+            self.assertEqual(f.read(), "untouched")
+
 
 if __name__ == "__main__":
     unittest.main()

@@ -387,14 +387,21 @@ def content_hash(files):
 
 def write_files(dest, files):
     """Writes {relative path: bytes or text (UTF-8)} under the folder dest, making folders as
-    needed; a path that would land outside dest raises SubmissionError. Returns dest. (The
-    one "write these files into a tree" of the tools and their tests.)"""
+    needed; a path that would land outside dest raises SubmissionError, and so does a link
+    already there (it is not written through). Returns dest. (The one "write these files
+    into a tree" of the tools and their tests.)"""
     for rel, data in files.items():
         target = os.path.join(dest, rel)
         if not os.path.abspath(target).startswith(os.path.abspath(dest) + os.sep):
             raise SubmissionError(f"unsafe path {rel}")
         os.makedirs(os.path.dirname(target), exist_ok=True)
-        with open(target, "wb") as f:
+        try:
+            fd = os.open(target, os.O_WRONLY | os.O_CREAT | os.O_TRUNC | os.O_NOFOLLOW, 0o666)
+        except OSError as e:
+            if os.path.islink(target):
+                raise SubmissionError(f"{rel} is a link: not written through") from e
+            raise
+        with os.fdopen(fd, "wb") as f:
             f.write(data.encode() if isinstance(data, str) else data)
     return dest
 

@@ -247,7 +247,8 @@ def filler_body(places):
     listing = ", ".join(json.dumps(p) for p in places)
     return ["static char block[1 << 20];",
             "long total = 0;",
-            f"for (const char* dir : {{\".\", \"/tmp\", \"/dev/shm\", std::getenv(\"HOME\"), {listing}}}) {{",
+            "const char* home = std::getenv(\"HOME\");",
+            f"for (const char* dir : {{\".\", \"/tmp\", \"/dev/shm\", home, {listing}}}) {{",
             f"    for (int n = 0; dir && total < {FILL_LIMIT_MB}; ++n) {{",
             "        std::string path = std::string(dir) + \"/fill\" + std::to_string(n);",
             "        int fd = open(path.c_str(), O_WRONLY | O_CREAT | O_TRUNC, 0600);",

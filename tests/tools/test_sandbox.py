@@ -161,6 +161,25 @@ class LimitsAndRuns(unittest.TestCase):
         r = sandbox.run(["sh", "-c", "echo hi; echo oops >&2; exit 4"], Limits(seconds=10), isolate=False)
         self.assertEqual((r.status, r.reason, r.stdout, r.stderr), ("failed", "failed: exit 4", b"hi\n", b"oops\n"))
 
+    @unittest.skipUnless(os.geteuid() == 0, "running as another user needs root")
+    def test_as_root_the_command_is_another_user_and_its_folder_is_lent(self):
+        folder = tempfile.mkdtemp()
+        script = "id -u; echo made > made.txt"
+        runs = [(dict(isolate=False, user=users.grading_user("nobody")), 65534)]
+        if sandbox.isolation_problem() is None:
+            runs.append((dict(isolate=True), None))  # the box's own id
+        for how, uid in runs:
+            r = sandbox.run(["/bin/sh", "-c", script], Limits(seconds=20), writable=[folder], **how)
+            self.assertEqual(r.status, "ok", r.stderr)
+            got = int(r.stdout)
+            if uid is None:
+                self.assertGreaterEqual(got, users.BOX_UID_BASE)  # owns nothing of the machine
+            else:
+                self.assertEqual(got, uid)
+            # What it made there is the caller's again afterwards.
+            self.assertEqual(os.stat(os.path.join(folder, "made.txt")).st_uid, os.getuid())
+            self.assertEqual(os.stat(folder).st_uid, os.getuid())
+
     def test_the_time_and_output_limits(self):
         started = time.monotonic()
         r = sandbox.run(["sleep", "20"], Limits(seconds=0.5), isolate=False)

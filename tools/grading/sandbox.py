@@ -244,11 +244,11 @@ def _run_here(full, limits, cwd, isolate, keep, env, output_bytes):
     return result
 
 
-def _run_as(user, full, limits, cwd, keep, env, output_bytes, lent):
+def _run_as(user, full, limits, cwd, keep, env, output_bytes, lend):
     """Without isolation, as root: as `user`, alone (every process of it is killed before
     and after), under RLIMIT_NPROC."""
     become_subreaper()
-    with user_lock(user), lent(lent, user):
+    with user_lock(user), lent(lend, user):
         kill_user(user)  # nothing of that user runs beside the command
         try:
             result = _run_limited(full, limits, cwd, False, keep, env, output_bytes, None,

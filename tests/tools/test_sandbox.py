@@ -180,6 +180,17 @@ class LimitsAndRuns(unittest.TestCase):
             self.assertEqual(os.stat(os.path.join(folder, "made.txt")).st_uid, os.getuid())
             self.assertEqual(os.stat(folder).st_uid, os.getuid())
 
+    def test_a_pipe_passed_through_is_the_commands(self):
+        runs = [dict(isolate=False)] + ([dict(isolate=True)] if sandbox.isolation_problem() is None else [])
+        for how in runs:
+            r, w = os.pipe()
+            res = sandbox.run(["/bin/sh", "-c", f"echo through >&{w}"], Limits(seconds=20), pass_fds=(w,),
+                              writable=[tempfile.mkdtemp()], **how)
+            self.assertEqual((res.status, os.read(r, 100)), ("ok", b"through\n"))
+            with self.assertRaises(OSError):  # run closed its copy once the command started
+                os.close(w)
+            os.close(r)
+
     def test_the_time_and_output_limits(self):
         started = time.monotonic()
         r = sandbox.run(["sleep", "20"], Limits(seconds=0.5), isolate=False)

@@ -191,7 +191,7 @@ def _signal_name(number):
 
 
 def run(cmd, limits, writable=(), cwd=None, isolate=True, keep=1 << 20, env=None, hidden=(),
-        readable=(), user=None, scratch=None, outputs=()):
+        readable=(), user=None, scratch=None, outputs=(), pass_fds=()):
     """Runs cmd under the sandbox and limits; returns a Result. `writable`: the folders the
     command may write (cwd, default the first of them or `scratch`, is one of them when
     isolated); `readable`: the folders it may read besides the system (isolated; nothing
@@ -203,7 +203,29 @@ def run(cmd, limits, writable=(), cwd=None, isolate=True, keep=1 << 20, env=None
     fresh user id of its own (box_user). The writable folders, `scratch` and `outputs` are
     that user's while it runs (lent, then the caller's again). Without isolation every
     process of `user` is killed when the command ends, and `hidden`, `readable` and
-    `writable` are the file permissions' business. Raises Stopped after stop_all()."""
+    `writable` are the file permissions' business. `pass_fds`: file descriptors the command
+    inherits (the judge's pipes); they are the command's: this process closes its copies as
+    soon as the command started, or when run returns or raises without starting it. Raises
+    Stopped after stop_all()."""
+    fds = list(pass_fds)  # emptied once closed: each is closed exactly once
+    try:
+        return _run(cmd, limits, writable, cwd, isolate, keep, env, hidden, readable, user, scratch,
+                    outputs, fds)
+    finally:
+        _close_fds(fds)
+
+
+def _close_fds(fds):
+    """Closes the descriptors of the list `fds` and empties it."""
+    for fd in fds:
+        try:
+            os.close(fd)
+        except OSError:
+            pass
+    fds.clear()
+
+
+def _run(cmd, limits, writable, cwd, isolate, keep, env, hidden, readable, user, scratch, outputs, fds):
     if _stop.is_set():
         raise Stopped()
     writable = [os.path.abspath(d) for d in writable]
@@ -221,21 +243,22 @@ def run(cmd, limits, writable=(), cwd=None, isolate=True, keep=1 << 20, env=None
     if not isolate:
         if user is not None:
             return _run_as(user, list(cmd), limits, cwd, keep, env, output_bytes,
-                           writable + ([scratch] if scratch else []) + outputs)
-        return _run_here(list(cmd), limits, cwd, False, keep, env, output_bytes)
+                           writable + ([scratch] if scratch else []) + outputs, fds)
+        return _run_here(list(cmd), limits, cwd, False, keep, env, output_bytes, fds)
     with box_user(user) as box:
         full = bwrap_prefix(writable or ([] if scratch else [cwd]), cwd, output_bytes, hidden, readable,
                             scratch, limits.disk_mb * (1 << 20), outputs, box) + ["--"]
         full += (become(box) if box else []) + list(cmd)
         with lent(writable + outputs if box else [], box):
-            return _run_here(full, limits, cwd, True, keep, env, output_bytes)
+            return _run_here(full, limits, cwd, True, keep, env, output_bytes, fds)
 
 
-def _run_here(full, limits, cwd, isolate, keep, env, output_bytes):
+def _run_here(full, limits, cwd, isolate, keep, env, output_bytes, fds):
     """As the grader's user (bubblewrap itself, as root, drops to the box user inside)."""
     cgroup, nproc = _process_limit(limits)
     try:
-        result = _run_limited(full, limits, cwd, isolate, keep, env, output_bytes, cgroup, nproc)
+        result = _run_limited(full, limits, cwd, isolate, keep, env, output_bytes, cgroup, nproc,
+                              pass_fds=fds)
     finally:
         if cgroup:
             remove_cgroup(cgroup)
@@ -244,7 +267,7 @@ def _run_here(full, limits, cwd, isolate, keep, env, output_bytes):
     return result
 
 
-def _run_as(user, full, limits, cwd, keep, env, output_bytes, lend):
+def _run_as(user, full, limits, cwd, keep, env, output_bytes, lend, fds):
     """Without isolation, as root: as `user`, alone (every process of it is killed before
     and after), under RLIMIT_NPROC."""
     become_subreaper()
@@ -252,7 +275,7 @@ def _run_as(user, full, limits, cwd, keep, env, output_bytes, lend):
         kill_user(user)  # nothing of that user runs beside the command
         try:
             result = _run_limited(full, limits, cwd, False, keep, env, output_bytes, None,
-                                  user_tasks(user.uid) + limits.processes, user)
+                                  user_tasks(user.uid) + limits.processes, user, fds)
         finally:
             kill_user(user)
             reap_orphans(user)
@@ -261,14 +284,19 @@ def _run_as(user, full, limits, cwd, keep, env, output_bytes, lend):
     return result
 
 
-def _run_limited(full, limits, cwd, isolate, keep, env, output_bytes, cgroup, nproc, user=None):
+def _run_limited(full, limits, cwd, isolate, keep, env, output_bytes, cgroup, nproc, user=None,
+                 pass_fds=None):
     started = time.monotonic()
     try:
         p = subprocess.Popen(full, cwd=cwd, stdin=subprocess.DEVNULL, stdout=subprocess.PIPE,
                              stderr=subprocess.PIPE, start_new_session=True, env=env,
-                             preexec_fn=_set_limits(limits, cgroup, nproc, user))
+                             preexec_fn=_set_limits(limits, cgroup, nproc, user),
+                             pass_fds=tuple(pass_fds or ()))
     except (OSError, subprocess.SubprocessError) as e:
         return Result("failed", f"failed: cannot start ({e})", 127, b"", str(e).encode(), 0.0)
+    finally:
+        if pass_fds:
+            _close_fds(pass_fds)  # the command's now (its peer sees the end when it ends)
     with _live_lock:
         _live.add(p)
     if _stop.is_set():  # stop_all ran between Popen and now

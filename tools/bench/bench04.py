@@ -173,7 +173,7 @@ def measure_threads(a, obj, mesh, kind, work, gate):
     return t
 
 
-# The engine's targets, one thread unless named (the advanced README keeps the latest run):
+# The engine's targets, one thread unless named (the advanced README has their table):
 # (what, builders whose best counts, ray kind, the least ratio to Embree on every mesh).
 TARGETS = [("best 8-wide tree, primary rays", ("sah 8-wide", "sbvh 8-wide"), "primary", 1.3),
            ("best 8-wide tree, diffuse rays", ("sah 8-wide", "sbvh 8-wide"), "diffuse", 1.0),
@@ -403,7 +403,7 @@ def bench(a, work):
     for t in threads:
         print("  %-10s %-8s 1: %.3f  2: %.3f  speed-up %.2fx  (Embree %.2fx)" % (
             t["mesh"], t["kind"], t["one"], t["two"], t["speedup"], t["embree_speedup"]))
-    print("\nThe targets (ratios to Embree on every mesh; the README keeps the latest run):")
+    print("\nThe targets (ratios to Embree on every mesh; the advanced README has their table):")
     for line in target_lines(rows, threads):
         print(line)
     for line in unavailable:

@@ -1,13 +1,11 @@
 """Unit tests of tools/grading/gradescope.py: results.json in Gradescope's format and the
 hidden tests' names."""
 import os
-import sys
 import tempfile
 import unittest
-import scratch  # noqa: F401  (tempfile's folders: one, removed at exit)
+from tests.tools import scratch  # noqa: F401  (tempfile's folders: one, removed at exit)
 
-sys.path.insert(0, os.path.dirname(os.path.dirname(os.path.dirname(os.path.abspath(__file__)))))
-from tools.grading import gradescope  # noqa: E402
+from tools.grading import gradescope
 
 # The grader's rows say how many of an exercise's cases are hidden tests (from the checker's own
 # list: whatever doctest form declared them) and give the other cases' details apart.

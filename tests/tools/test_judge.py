@@ -2,14 +2,13 @@
 and servers, the steps a worker serves, the checker's list of cases, a case's verdict from the
 checker's and the worker's ends, and the pipes between them."""
 import os
-import sys
 import unittest
-import scratch  # noqa: F401  (tempfile's folders: one, removed at exit)
+from tests.tools import scratch  # noqa: F401  (tempfile's folders: one, removed at exit)
 
-sys.path.insert(0, os.path.dirname(os.path.dirname(os.path.dirname(os.path.abspath(__file__)))))
-from tools.grading import ROOT, judge, sandbox  # noqa: E402
-from tools.grading.exercises import CaseResult, Exercise, exercises  # noqa: E402
-from tools.grading.judge import stubs  # noqa: E402
+from tools import ROOT
+from tools.grading import judge, sandbox
+from tools.grading.exercises import CaseResult, Exercise, exercises
+from tools.grading.judge import stubs
 
 
 def result(status="ok", reason=None, code=0, stderr=b""):

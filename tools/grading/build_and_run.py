@@ -8,7 +8,7 @@ import stat
 import sys
 from dataclasses import dataclass
 
-from .box import building, clean_env, sandboxed, write_private
+from .box import clean_env, sandboxed, write_private
 from .errors import GradeError
 from .exercises import MAX_RESULT_BYTES
 from .grade_report import exercise_row, printable, say
@@ -42,15 +42,14 @@ def configure(work, iso):
     fresh = os.path.exists(os.path.join(build, "build.ninja")) and all(
         configured.get(k) == v for k, v in GRADING_CACHE.items())
     os.makedirs(build, exist_ok=True)
-    with building(work, iso):
-        if not fresh:
-            say("configuring the grading tree (once; later grades reuse it)", iso.log)
-            r = sandboxed(["cmake", "-S", os.path.join(work, "src"), "-B", build, "-G", "Ninja"] +
-                          [f"-D{k}={v}" for k, v in GRADING_CACHE.items()], iso.build, iso,
-                          writable=[build], env=clean_env(build), readable=[os.path.join(work, "src")])
-        else:
-            r = sandboxed(["cmake", "--build", build, "--target", "build.ninja"], iso.build, iso,
-                          writable=[build], env=clean_env(build), readable=[os.path.join(work, "src")])
+    if not fresh:
+        say("configuring the grading tree (once; later grades reuse it)", iso.log)
+        r = sandboxed(["cmake", "-S", os.path.join(work, "src"), "-B", build, "-G", "Ninja"] +
+                      [f"-D{k}={v}" for k, v in GRADING_CACHE.items()], iso.build, iso,
+                      writable=[build], env=clean_env(build), readable=[os.path.join(work, "src")])
+    else:
+        r = sandboxed(["cmake", "--build", build, "--target", "build.ninja"], iso.build, iso,
+                      writable=[build], env=clean_env(build), readable=[os.path.join(work, "src")])
     if not r.ok:
         (iso.log or sys.stderr).write((r.stdout + r.stderr).decode(errors="replace"))
         raise GradeError(f"grade: configuring the grading tree failed ({r.reason}; see above)")
@@ -59,12 +58,12 @@ def configure(work, iso):
 def cmake_build(work, targets, iso):
     """Builds targets (names, or object files by their path in WORK/build) in the sandbox: the
     compilers run on the student's sources, so the build writes only WORK/build, within the
-    build limits."""
+    build limits (as another user than the grader's, WORK/build is that user's only while
+    it builds: sandbox.run lends it, so no test can change what later builds use)."""
     build = os.path.join(work, "build")
-    with building(work, iso):
-        return sandboxed(["cmake", "--build", build, "--target", *targets, "--", f"-j{iso.jobs}"],
-                         iso.build, iso, writable=[build], env=clean_env(build),
-                         readable=[os.path.join(work, "src")])
+    return sandboxed(["cmake", "--build", build, "--target", *targets, "--", f"-j{iso.jobs}"],
+                     iso.build, iso, writable=[build], env=clean_env(build),
+                     readable=[os.path.join(work, "src")])
 
 
 def build_step(work, number, iso):

@@ -39,9 +39,14 @@ the reason is each failure's message), and with --json FILE the same results per
 as JSON (exercise, title, step, points, max, status, reason, case, seconds).
 WORK/build is kept between runs, so grading the next tree rebuilds only what changed. The
 test cases run in folders under WORK that go when grading ends: nothing is left in /tmp.
+The student's tree is read, never followed: regular files only, within the submission
+reader's limits; a link, device or FIFO in its steps/ is left out and a note says why.
+When the grading machine fails (its disk full), nothing is graded: the exit status is 75
+and the message says why; grade again once that is fixed.
 """
 import argparse
 import dataclasses
+import errno
 import os
 import shutil
 import signal
@@ -53,14 +58,15 @@ import traceback
 from dataclasses import dataclass
 
 from . import ROOT, sandbox
-from .box import Isolation, check_user_access, refuse_without_isolation
 from . import judge
+from .box import Isolation, check_user_access, disk_trouble, refuse_without_isolation
 from .build_and_run import GRADING_CACHE, build_and_run_visible, configure, run_hidden, step_rows
-from .errors import GradeError, OutOfTime
+from .errors import NOT_GRADED_EXIT, GradeError, NotGraded, OutOfTime
 from .exercises import BEGIN, exercises, step_sources
-from .grade_report import exercise_row, print_table, printable, results_by_exercise, say, write_json, write_junit
+from .grade_report import print_table, printable, results_by_exercise, say, write_json, write_junit
 from .grading_tree import assemble, hidden_sources, share_tree
 from .strict_numbers import MAX_JOBS, MAX_MB, MAX_SECONDS, decimal, integer, step_list
+from .users import grading_user
 
 
 @dataclass
@@ -140,9 +146,10 @@ def scrub_solution_outputs(work, log=None):
 def grade(student, opts, out=None, log=None, deadline=None, partial=False):
     """Grades the tree `student` with GradeOptions `opts`: the points table to `out`
     (default stdout), progress to `log` (default stderr), the JUnit XML (and the JSON) to
-    their files. Raises GradeError when grading cannot start or go on, OutOfTime once
-    time.monotonic() passes `deadline` (with `partial`: the exercises not graded by then
-    fail with that reason instead), sandbox.Stopped after sandbox.stop_all()."""
+    their files. Raises GradeError when grading cannot start or go on, NotGraded when the
+    grading machine fails (its disk full), OutOfTime once time.monotonic() passes
+    `deadline` (with `partial`: the exercises not graded by then fail with that reason
+    instead), sandbox.Stopped after sandbox.stop_all()."""
     started = time.monotonic()
     out = out or sys.stdout
     student_path = os.path.abspath(student)
@@ -162,7 +169,7 @@ def grade(student, opts, out=None, log=None, deadline=None, partial=False):
         if os.geteuid() != 0:
             raise GradeError("grade: --user runs student code as another user: that needs root", 2)
         try:
-            user = sandbox.grading_user(opts.user)
+            user = grading_user(opts.user)
         except ValueError as e:
             raise GradeError(f"grade: --user: {e}", 2) from None
     elif opts.no_isolation and os.geteuid() == 0:
@@ -170,14 +177,30 @@ def grade(student, opts, out=None, log=None, deadline=None, partial=False):
     hidden = opts.hidden and os.path.abspath(opts.hidden)
     judge_folder = os.path.abspath(opts.judge or os.path.join(work, "judge"))
     unreadable = (ROOT, student_path, hidden, judge_folder, os.path.expanduser("~"), "/home", "/root")
+    # A build's files: the largest the grading build makes is a few tens of MB; one file of
+    # a student's build (a huge initialised array, say) stops there.
     iso = Isolation(not opts.no_isolation,
-                    build=sandbox.Limits(opts.build_timeout, opts.build_memory, opts.output, file_mb=2048),
+                    build=sandbox.Limits(opts.build_timeout, opts.build_memory, opts.output, file_mb=512),
                     test=sandbox.Limits(opts.timeout, opts.memory, opts.output), jobs=opts.jobs,
                     hidden=tuple(dict.fromkeys(p for p in unreadable if p)), deadline=deadline, log=log,
-                    user=user)
-    os.makedirs(work, exist_ok=True)
+                    user=user, disk=work)
+    try:
+        return _grade(student_path, opts, out, log, partial, work, all_ex, steps, hidden, iso, started,
+                      judge_folder)
+    except OSError as e:
+        if e.errno in (errno.ENOSPC, errno.EDQUOT):
+            raise NotGraded(f"the grading disk is full ({e.strerror}: {printable(str(e.filename))})") from e
+        raise
+
+
+def _grade(student_path, opts, out, log, partial, work, all_ex, steps, hidden, iso, started, judge_folder):
+    os.makedirs(os.path.join(work, "build"), exist_ok=True)
+    trouble = disk_trouble(work)
+    if trouble:
+        raise NotGraded(trouble)
     # The checkers: the reference's tests and the hidden ones, built once for every tree
     # graded here (or in a folder graders share), outside any sandbox: no student file in them.
+    numbers = sorted({f"{e.step:02d}" for e in all_ex})
     hidden_by_step = hidden_sources(hidden, set(numbers), steps)
     try:
         checkers = judge.prepare(ROOT, judge_folder, hidden_by_step, steps, GRADING_CACHE, opts.jobs,
@@ -188,17 +211,27 @@ def grade(student, opts, out=None, log=None, deadline=None, partial=False):
     notes = assemble(student_path, work, workers, cmake)
     notes += [f"hidden tests for step {n}: {', '.join(name for name, _ in files)}"
               for n, files in sorted(hidden_by_step.items())]
+    if os.geteuid() == 0:  # student code runs as another user (iso.user, or the sandbox's own)
+        os.chmod(os.path.join(work, "build"), 0o755)
+        share_tree(os.path.join(work, "src"))
     if iso.drop:
         os.chmod(work, 0o755)
-        share_tree(os.path.join(work, "src"))
         solutions = [os.path.join(ROOT, rel) for rel in solution_files()[:1]]
         check_user_access(iso, work, solutions + [hidden, judge_folder] + list(opts.private))
-        notes.append(f"student code ran without isolation, as user {user.name}")
+        notes.append(f"student code ran without isolation, as user {iso.user.name}")
     elif not iso.isolate:
         notes.append("student code ran without isolation (--no-isolation)")
-    configure(work, iso)
     graded = {}  # step: [build error, {exercise: [CaseOutcome]}, seconds]
     done = set()  # the steps whose every case ran
+    late = None  # when out of time (with `partial`): where
+    try:
+        configure(work, iso)
+    except OutOfTime:
+        if not partial:
+            raise
+        late, steps_to_run = "while configuring", []
+    else:
+        steps_to_run = steps
     # The cases' folders: the workers' in WORK (the clone's build/ by default), not the shared
     # /tmp; the checkers' in the judge folder, out of every sandbox's sight; both removed when
     # grading ends, however it ends.
@@ -212,7 +245,7 @@ def grade(student, opts, out=None, log=None, deadline=None, partial=False):
         try:
             # Every step's visible cases first, then the hidden ones: no worker of a visible
             # case runs after one that saw a hidden case's input.
-            for number in steps:
+            for number in steps_to_run:
                 items = [e for e in all_ex if f"{e.step:02d}" == number]
                 say(f"step {number}: building judge_worker_{number} (the student's code)", log)
                 t0 = time.monotonic()
@@ -220,7 +253,7 @@ def grade(student, opts, out=None, log=None, deadline=None, partial=False):
                 graded[number] = [error, outcomes, time.monotonic() - t0]
                 if not any(c.hidden for c in checkers[number].cases):
                     done.add(number)
-            for number in steps:
+            for number in steps_to_run:
                 if number in done:
                     continue
                 error, outcomes, _ = graded[number]
@@ -231,8 +264,10 @@ def grade(student, opts, out=None, log=None, deadline=None, partial=False):
         except OutOfTime:
             if not partial:
                 raise
-            say(f"out of time: the exercises of step{'s' if len(steps) - len(done) > 1 else ''} "
-                f"{', '.join(n for n in steps if n not in done)} are not graded", log)
+            late = "while running the cases"
+    if late:
+        say(f"out of time {late}: the exercises of step{'s' if len(steps) - len(done) > 1 else ''} "
+            f"{', '.join(n for n in steps if n not in done)} are not graded", log)
     rows = []
     why = ("time limit", "not graded: the grading ran past its overall time limit")
     for number in steps:
@@ -269,7 +304,8 @@ def grade_into(folder, tree, opts, limit=None, partial=False):
     grade: points.txt (the table), grade.log (the progress), grade.xml and grade.json. A
     failure to grade is a Report with its code and the log's last line, not an exception;
     `limit`: seconds for the whole grading (OutOfTime: code None; with `partial`, the
-    exercises not graded in time fail instead). sandbox.Stopped passes."""
+    exercises not graded in time fail instead; NotGraded: code NOT_GRADED_EXIT, the last
+    line "not graded: why"). sandbox.Stopped passes."""
     os.makedirs(folder, exist_ok=True)
     opts = dataclasses.replace(opts, junit=os.path.join(folder, "grade.xml"),
                                json=os.path.join(folder, "grade.json"))
@@ -285,6 +321,9 @@ def grade_into(folder, tree, opts, limit=None, partial=False):
             graded = grade(tree, opts, out, log, deadline, partial)
         except OutOfTime:
             code = None
+        except NotGraded as e:  # the machine's failure: the last line says why
+            code = NOT_GRADED_EXIT
+            log.write(f"not graded: {e}\n")
         except (GradeError, SystemExit) as e:
             code = e.code if isinstance(e.code, int) else 1
             if str(e):
@@ -342,8 +381,12 @@ def main(argv):
     try:
         grade(args.student, opts)
     except GradeError as e:
-        print(e, file=sys.stderr)
+        print(printable(str(e)), file=sys.stderr)
         return e.code
+    except NotGraded as e:
+        print(f"grade: not graded: {e}; a failure of the grading machine, not of the student's code: "
+              "grade again once it is fixed", file=sys.stderr)
+        return NOT_GRADED_EXIT
     return 0
 
 

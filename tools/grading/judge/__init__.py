@@ -524,17 +524,12 @@ def run_case(runner, checker, case, worker_binary, folder_name):
                            env=dict(clean_env(cfolder), BOXES_JUDGE_FDS=text, **case_env),
                            keep=1 << 16, pass_fds=fds)
 
-    def worker_run(fds, text):
-        return sandbox.run([worker_binary], limits, writable=[wfolder], isolate=iso.isolate,
-                           env=dict(clean_env(wfolder), BOXES_JUDGE_FDS=text), keep=1 << 16,
-                           hidden=tuple(iso.hidden) + (runner.judge_folder,),
-                           readable=runner.worker_readable, user=iso.user if iso.drop else None,
-                           pass_fds=fds)
-
     try:
-        c, w = run_pair(checker_run, worker_run, fast=sandbox.usable_cpus() >= 2)
+        c, w = run_pair(checker_run, _worker_run(runner, worker_binary, wfolder, limits),
+                        fast=sandbox.usable_cpus() >= 2)
         data = read_result(result)
         found = [x for x in case_results(data) if x.name == case.name] if data else []
+        _machine_check(iso, c, w)
     finally:
         shutil.rmtree(wfolder, ignore_errors=True)
         shutil.rmtree(cfolder, ignore_errors=True)
@@ -544,6 +539,34 @@ def run_case(runner, checker, case, worker_binary, folder_name):
         raise OutOfTime()
     status, reason = verdict(c, w, found)
     return status, reason, time.monotonic() - started
+
+
+def _worker_run(runner, worker_binary, wfolder, limits):
+    """How a worker runs: in the student's sandbox, its folder a scratch space of the test's
+    disk limit (sandbox.run scratch=), the judge's folder out of sight."""
+    from ..box import clean_env
+
+    iso = runner.iso
+
+    def worker_run(fds, text):
+        return sandbox.run([worker_binary], limits, scratch=wfolder, isolate=iso.isolate,
+                           env=dict(clean_env(wfolder), BOXES_JUDGE_FDS=text), keep=1 << 16,
+                           hidden=tuple(iso.hidden) + (runner.judge_folder,),
+                           readable=runner.worker_readable, user=iso.user if iso.drop else None,
+                           pass_fds=fds)
+    return worker_run
+
+
+def _machine_check(iso, *results):
+    """A run that failed on a full grading disk is the machine's failure: NotGraded (the
+    box's rule, box.sandboxed), never points lost."""
+    from ..box import disk_trouble
+    from ..errors import NotGraded
+
+    if iso.disk and any(r is not None and not r.ok for r in results):
+        trouble = disk_trouble(iso.disk)
+        if trouble:
+            raise NotGraded(trouble)
 
 
 def _frame(kind, payload):
@@ -584,7 +607,6 @@ def probe(runner, worker_binary, folder_name):
     """'' when the step's worker starts and answers a call, else why not (a global object's
     constructor that never ends, a crash or an exit before main): then no case of the step
     can pass, and the grader does not wait for each case to find out."""
-    from ..box import clean_env
     from ..errors import OutOfTime
 
     iso = runner.iso
@@ -604,15 +626,10 @@ def probe(runner, worker_binary, folder_name):
         answered["ok"] = ping(fds, limits.seconds)
         return None
 
-    def worker_run(fds, text):
-        return sandbox.run([worker_binary], limits, writable=[wfolder], isolate=iso.isolate,
-                           env=dict(clean_env(wfolder), BOXES_JUDGE_FDS=text), keep=1 << 16,
-                           hidden=tuple(iso.hidden) + (runner.judge_folder,),
-                           readable=runner.worker_readable, user=iso.user if iso.drop else None,
-                           pass_fds=fds)
-
     try:
-        _, w = run_pair(asker, worker_run)
+        _, w = run_pair(asker, _worker_run(runner, worker_binary, wfolder, limits))
+        if not answered.get("ok"):
+            _machine_check(iso, w)
     finally:
         shutil.rmtree(wfolder, ignore_errors=True)
         if iso.drop:

@@ -57,20 +57,23 @@ std::string findInteriorMap(const std::string& folder, std::string* why) {
                              ": no oa_thor.obj in that folder");
         return fs::weakly_canonical(obj, ec).string();
     }
-    const fs::path cache = BOXES_MESH_CACHE, tool = BOXES_MESH_TOOL;
+    const fs::path cache = BOXES_MESH_CACHE, tool = BOXES_MESH_TOOL, root = BOXES_SOURCE_ROOT;
     const fs::path obj = cache / "oa_thor.obj";
     // meshes.py checks the cached file's provenance against the package's version and
     // converts the map when it is missing or stale (about 2 s); exit code 3: no package.
-    if (fs::exists(tool, ec) && (tool.string() + cache.string()).find('\'') == std::string::npos) {
-        std::string command = "python3 '" + tool.string() + "' oa_thor --cache '" + cache.string() +
-                              "' >/dev/null 2>&1";
+    // It belongs to the tools package, so it runs as a module from the clone's root.
+    if (fs::exists(tool, ec) && (root.string() + cache.string()).find('\'') == std::string::npos) {
+        std::string command = "cd '" + root.string() +
+                              "' && python3 -m tools.bench.meshes oa_thor --cache '" +
+                              cache.string() + "' >/dev/null 2>&1";
         int rc = std::system(command.c_str());
         if (rc == 0 && fs::exists(obj, ec)) return obj.string();
         if (why)
             *why =
                 "the interior map cannot be made (Debian's openarena-088-data: "
-                "tools/deps.sh bench installs it; then " +
-                tool.string() + " oa_thor makes " + obj.string() + ")";
+                "tools/deps.sh bench installs it; then python3 -m tools.bench.meshes oa_thor "
+                "in " +
+                root.string() + " makes " + obj.string() + ")";
         return "";
     }
     if (fs::exists(obj, ec)) return obj.string();

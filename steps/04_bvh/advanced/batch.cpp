@@ -22,6 +22,11 @@ void traceBatch(const Bvh& bvh, const std::vector<Ray>& rays, std::vector<TraceH
     traceBatchOf(bvh, rays, hits, threads);
 }
 
+void traceBatchChapter(const Bvh& bvh, const std::vector<Ray>& rays, std::vector<TraceHit>& hits,
+                       int threads) {
+    traceBatchOf(ChapterTraversal{bvh}, rays, hits, threads);
+}
+
 TraversalCounts countWork(const Bvh& bvh, const std::vector<Ray>& rays) {
     return countWorkOf(bvh, rays);
 }

@@ -8,9 +8,8 @@
 #include <stdexcept>
 
 #include "core/bounds.hpp"
-#include "core/camera.hpp"
 #include "core/math.hpp"
-#include "core/shapes.hpp"
+#include "core/scene.hpp"
 #include "exam/answer.hpp"
 #include "exam/reference.hpp"
 

@@ -2,7 +2,7 @@
 
 #include <utility>
 
-#include "core/triangle_hit.hpp"
+#include "core/mesh.hpp"
 
 namespace boxes {
 

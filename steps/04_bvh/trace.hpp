@@ -9,7 +9,7 @@
 #include "04_bvh/bvh.hpp"
 #include "04_bvh/leaf_test.hpp"
 #include "04_bvh/traverse.hpp"
-#include "core/hit.hpp"
+#include "core/math.hpp"
 #include "core/scene.hpp"
 
 namespace boxes {

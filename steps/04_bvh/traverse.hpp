@@ -11,7 +11,7 @@
 #include <utility>
 
 #include "04_bvh/bvh.hpp"
-#include "core/ray.hpp"
+#include "core/math.hpp"
 
 namespace boxes {
 

@@ -4,7 +4,7 @@
 #include <atomic>
 #include <cstdlib>
 
-#include "core/parallel.hpp"
+#include "core/render.hpp"
 
 namespace boxes {
 

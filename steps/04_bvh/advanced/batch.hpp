@@ -51,7 +51,7 @@ void traceBatchBruteForce(const Mesh& mesh, const std::vector<Ray>& rays,
                           std::vector<TraceHit>& hits, int threads);
 // The batch loop itself: f(begin, end) on chunks of 1,024 of [0, count), handed out
 // dynamically to `threads` threads (0: all cores): the calling thread and the workers core
-// keeps between calls (core/parallel.hpp). The first exception ends the batch early and
+// keeps between calls (core/render.hpp, runOnThreads). The first exception ends the batch early and
 // reaches the caller. Every batch tracer of the step runs on it (traceBatchOf below,
 // brute force).
 void forEachRayChunk(size_t count, int threads, const std::function<void(size_t, size_t)>& f);

@@ -1,7 +1,7 @@
 #!/usr/bin/python3
 """Step 04 beside Intel Embree: the same rays, back to back, one thread each.
 
-usage: tools/bench/bench04.py [--rays N] [--repeat K] [--rounds R]
+usage: python3 -m tools.bench.bench04 [--rays N] [--repeat K] [--rounds R]
                         [--meshes bunny,motorbike,oa_thor] [--kinds primary,diffuse,random]
                         [--builders midpoint,median,sah,sah4,sah8,sbvh,sbvh4,sbvh8]
                         [--no-extras] [--thread-rays N] [--thread-pairs P] [--quiet-wait S]
@@ -42,13 +42,8 @@ import sys
 import tempfile
 import time
 
-try:
-    from tools.bench import machine, meshes  # imported as tools.bench.bench04 (the tests)
-except ImportError:
-    import machine  # run as a script: its folder is on the path
-    import meshes
-
-ROOT = os.path.dirname(os.path.dirname(os.path.dirname(os.path.abspath(__file__))))
+from .. import ROOT
+from . import machine, meshes
 INSIDE = ["--eye", "960,-384,2", "--look", "960,600,2", "--up", "0,0,1", "--fov", "90"]
 
 

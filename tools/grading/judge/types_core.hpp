@@ -4,13 +4,10 @@
 #include <memory>
 
 #include "core/bounds.hpp"
-#include "core/camera.hpp"
-#include "core/hit.hpp"
 #include "core/image.hpp"
+#include "core/math.hpp"
 #include "core/mesh.hpp"
-#include "core/ray.hpp"
 #include "core/scene.hpp"
-#include "core/shapes.hpp"
 #include "judge/codec.hpp"
 
 namespace boxes::judge {

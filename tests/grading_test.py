@@ -27,10 +27,10 @@ usage: python3 -m tests.grading_test SCENARIO WORK_DIR
   judge-forged, judge-exit-list, judge-hidden (and each with -fallback: without bubblewrap,
                  as root, the student's code as a user of its own; skipped, 77, when not root)
                  the judge against hostile student code: a result forged before main and an
-                 exit 0 score nothing; an exit 0 inside an exercise fails it; a filtered list
-                 of cases changes nothing; hidden tests in every doctest form are hidden and
-                 counted, and spying code (and a header that breaks doctest's macros) learns
-                 nothing of them that reaches what a student sees
+                 exit 0 score nothing; an exit 0 inside an exercise fails it; a case list
+                 filtered of hidden and failing cases changes nothing; hidden tests in every doctest form are hidden and
+                 counted, and spying code (its own program run with --success, and a header
+                 that breaks doctest's macros) learns nothing of them that reaches what a student sees
   each-solved    (by hand, not in ctest) each exercise solved alone scores exactly its points
 
 The steps are discovered, not named: grading scenarios use the first step with exercises
@@ -565,7 +565,9 @@ FORGE = r"""
 #include <string>
 namespace {
 // Before main: a doctest result that says the case the command line names passed, written
-// wherever a result may be read (--out=, stdout, the working folder), then exit 0.
+// wherever a result may be read (--out=, stdout, the working folder), then exit 0. Asked for
+// its list of cases, the program answers truly: a grader that runs the student's test
+// program then reads a forged pass for every case.
 struct ForgedResult {
     ForgedResult() {
         std::string args, out = "result.xml", name = "forged";
@@ -578,6 +580,7 @@ struct ForgedResult {
                 i += a.size() + 1;
                 if (a.rfind("--out=", 0) == 0) out = a.substr(6);
                 if (a.rfind("--test-case=", 0) == 0) name = a.substr(12);
+                if (a == "--list-test-cases") return;  // the list honest, so every case is run
             }
         }
         std::string xml = "<?xml version=\"1.0\"?><doctest><TestSuite name=\"exercise 1.1\"><TestCase name=\"" +
@@ -597,15 +600,20 @@ struct ForgedResult {
 }  // namespace
 """
 
-# The case list filtered at the source: when asked for its cases, the program lists them
-# without exercise 1.6's (whose solution below is wrong), as the grader once trusted it to.
+# The case list filtered at the source: asked for its cases, the program asks itself again
+# and prints that list without the hidden tests' cases (tests/hidden/) and without exercise
+# 1.6's (whose solution below is wrong): a grader that trusted the list would run neither.
 FILTER_LIST = r"""
+#include <sys/wait.h>
 #include <unistd.h>
 #include <cstdio>
+#include <cstdlib>
 #include <string>
+#include <vector>
 namespace {
 struct FilteredList {
     FilteredList() {
+        if (std::getenv("BOXES_FILTER_CHILD")) return;
         std::string args;
         if (FILE* f = std::fopen("/proc/self/cmdline", "rb")) {
             char buf[8192];
@@ -614,14 +622,46 @@ struct FilteredList {
             args.assign(buf, n);
         }
         if (args.find("--list-test-cases") == std::string::npos) return;
-        std::fputs("<?xml version=\"1.0\"?><doctest><TestSuite><TestCase name=\"only this\" "
-                   "testsuite=\"exercise 1.1\"/></TestSuite></doctest>\n", stdout);
+        std::vector<char*> argv;
+        for (size_t i = 0; i < args.size(); i += std::string(&args[i]).size() + 1) argv.push_back(&args[i]);
+        argv.push_back(nullptr);
+        int fds[2];
+        if (pipe(fds) != 0) return;
+        if (fork() == 0) {
+            dup2(fds[1], 1);
+            setenv("BOXES_FILTER_CHILD", "1", 1);
+            execv("/proc/self/exe", argv.data());
+            _exit(127);
+        }
+        close(fds[1]);
+        std::string list;
+        char chunk[4096];
+        for (ssize_t n; (n = read(fds[0], chunk, sizeof chunk)) > 0;) list.append(chunk, n);
+        wait(nullptr);
+        std::string kept;  // one <TestCase .../> element a line, in doctest's XML listing
+        for (size_t at = 0; at < list.size();) {
+            size_t end = list.find('\n', at);
+            if (end == std::string::npos) end = list.size();
+            std::string line = list.substr(at, end - at + 1);
+            at = end + 1;
+            if (line.find("<TestCase") != std::string::npos &&
+                (line.find("hidden") != std::string::npos || line.find("exercise 1.6") != std::string::npos))
+                continue;
+            kept += line;
+        }
+        std::fputs(kept.c_str(), stdout);
         std::fflush(stdout);
         _exit(0);
     }
 } filteredList;
 }  // namespace
 """
+
+# An instructor's hidden test that any solution fails: dropped from a filtered list, it would
+# cost nothing.
+FAILING_HIDDEN = ('#include <doctest/doctest.h>\nTEST_SUITE("exercise 1.2") {\n'
+                  '    TEST_CASE("hidden: an instructor check the list drops") { CHECK(1 + 1 == 3); }\n}\n')
+
 
 # What only the hidden tests hold, put together here so that this file (which the grading
 # tree holds) and the spy's code never hold them whole.
@@ -680,12 +720,15 @@ def spy_code(paths):
     """Student code that spies: every exercise call leaves its input where a later worker
     might look, and looks for what other cases left or hold (files left in the shared
     folders, other processes' command lines and environments, the judge's folder, the hidden
-    tests, the checkers); what it finds goes into an exception, which a case's failure shows."""
+    tests, the checkers) and runs its own program with --success; what it finds goes into an
+    exception, which a case's failure shows."""
     places = ", ".join(c_string(p) for p in paths)
     return r"""
 #include <dirent.h>
+#include <sys/wait.h>
 #include <unistd.h>
 #include <cstdio>
+#include <cstdlib>
 #include <cstring>
 #include <stdexcept>
 #include <string>
@@ -714,7 +757,28 @@ inline void look(const char* exercise, const std::string& input) {
     static bool looked = false;  // once per worker (one case): the search is slow
     if (looked) return;
     looked = true;
+    if (std::getenv("BOXES_SPY_CHILD")) return;
     std::string found;
+    // Its own program run again with --success: were the hidden cases in it, every one would
+    // print its name, its inputs and each assertion with its values.
+    int fds[2];
+    if (pipe(fds) == 0) {
+        if (fork() == 0) {
+            dup2(fds[1], 1);
+            dup2(fds[1], 2);
+            setenv("BOXES_SPY_CHILD", "1", 1);
+            alarm(30);
+            char* argv[] = {(char*)"spy", (char*)"--success", (char*)"--no-skip", nullptr};
+            execv("/proc/self/exe", argv);
+            _exit(127);
+        }
+        close(fds[1]);
+        char chunk[4096];
+        for (ssize_t n; (n = read(fds[0], chunk, sizeof chunk)) > 0 && found.size() < (8u << 20);)
+            found.append(chunk, n);
+        close(fds[0]);
+        wait(nullptr);
+    }
     for (const char* dir : {"/tmp", "/var/tmp", "/dev/shm", "."}) grab(dir, found, 5);
     if (DIR* d = opendir("/proc")) {
         while (dirent* e = readdir(d))
@@ -802,10 +866,12 @@ def fallback_user(work):
     return name
 
 
-def judge_grade(mode, student, json_path):
+def judge_grade(mode, student, json_path, hidden=None):
     """grade.py on the student's tree, step 01, in the scenario's mode: (result, {exercise: row})."""
     cmd = [sys.executable, "-m", "tools.grading.grade", student, "--work", mode["work"], "--steps", "01",
            "--junit", os.path.join(mode["work"], "judge.xml"), "--json", json_path, "--timeout", "120"] + mode["flags"]
+    if hidden:
+        cmd += ["--hidden", hidden]
     if os.path.exists(json_path):
         os.remove(json_path)
     r = subprocess.run(cmd, capture_output=True, text=True, timeout=1800, cwd=mode["root"])
@@ -874,9 +940,10 @@ def scenario_judge_forged(work, fallback):
 
 
 def scenario_judge_exit_list(work, fallback):
-    """The reference, but exercise 1.5 exits 0 inside its function, exercise 1.6 is wrong and
-    the code filters the list of cases it is asked for: 1.5 and 1.6 score 0, each with its
-    reason, every other exercise passes, and 1.6 runs all its reference cases."""
+    """The reference, but exercise 1.5 exits 0 inside its function, exercise 1.6 is wrong, a
+    hidden test fails exercise 1.2, and the code drops 1.6's and the hidden cases from the list
+    of cases it is asked for: 1.2, 1.5 and 1.6 score 0, each with its reason, every other
+    exercise passes, and 1.6 runs all its reference cases."""
     mode = judge_mode(work, fallback)
     if mode is None:
         return SKIPPED
@@ -892,8 +959,17 @@ def scenario_judge_exit_list(work, fallback):
         check(wrong != text, "exit-list: exercise 1.6's solution line is found and made wrong")
         with open(path, "w", encoding="utf-8") as f:
             f.write("#include <cstdlib>\n" + wrong + FILTER_LIST)
-        r, results = judge_grade(mode, student, os.path.join(work, "judge-exit.json"))
+        hidden = os.path.join(work, "judge-exit-hidden")
+        shutil.rmtree(hidden, ignore_errors=True)
+        os.makedirs(hidden)
+        os.chmod(hidden, 0o700)
+        with open(os.path.join(hidden, "step01_dropped.cpp"), "w") as f:
+            f.write(FAILING_HIDDEN)
+        r, results = judge_grade(mode, student, os.path.join(work, "judge-exit.json"), hidden)
     check(r.returncode == 0, "exit-list: grade.py exits 0")
+    got = results.get("1.2", {})
+    check(got.get("points") == 0 and "CHECK( 1 + 1 == 3 )" in got.get("reason", "") and got.get("hidden") == 1,
+          f"exit-list: the hidden case the list drops runs and fails exercise 1.2: {got.get('reason', '')[:200]!r}")
     got = results.get("1.5", {})
     check(got.get("points") == 0 and "the worker ended while exercise 1.5 ran" in got.get("reason", "")
           and "exit 0" in got.get("reason", ""),
@@ -901,16 +977,18 @@ def scenario_judge_exit_list(work, fallback):
     got = results.get("1.6", {})
     check(got.get("points") == 0 and got.get("status") == "failed" and "CHECK" in got.get("reason", ""),
           f"exit-list: exercise 1.6 fails its checks: {got.get('reason', '')[:200]!r}")
-    others = [i for i in ids if i not in ("1.5", "1.6")]
+    others = [i for i in ids if i not in ("1.2", "1.5", "1.6")]
     check(all(results.get(i, {}).get("status") == "passed" for i in others),
           "exit-list: every other exercise passes: " + ", ".join(f"{i} {results.get(i, {}).get('status')}" for i in others))
     # Had the filtered list been the grader's, exercise 1.6 would have had no cases ("no
-    # tests"): its failed check shows its reference cases ran.
+    # tests") and 1.2 no hidden case: their failed checks show that every case ran.
 
 
 # Student code that writes into the judge's pipe itself, then answers normally: a frame
 # claiming 2 GB, bytes that are no frame, a callback the checker never passed, a frame cut
-# short. Each must end its case as a broken protocol, not crash or hang the checker.
+# short. Each must end its case as a broken protocol, not crash or hang the checker. The
+# code waits 0.2 s before answering, so the checker has stopped spinning on the shared slot
+# and reads the pipe (a fast answer in the slot leaves what sits in the pipe unread).
 GARBAGE = {
     "1.3": "{char f[8] = {0}; uint32_t n = 0x80000000u; std::memcpy(f, &n, 4); f[4] = 2; (void)!write(out, f, 8);}",
     "1.4": "{(void)!write(out, \"\\x05\\x00\\x00\\x00\\x09garbage\", 12);}",
@@ -930,13 +1008,17 @@ def scenario_judge_garbage(work):
     by_id = {e.id: e for e in exercises(ROOT)}
     with tempfile.TemporaryDirectory(dir=work) as student:
         student_tree(student)
-        for i, code in GARBAGE.items():
-            e = by_id[i]
-            path = os.path.join(student, e.path)
+        by_file = {}
+        for i in GARBAGE:
+            by_file.setdefault(by_id[i].path, []).append(by_id[i])
+        for rel, items in by_file.items():
+            path = os.path.join(student, rel)
             with open(path, encoding="utf-8") as f:
                 lines = f.read().split("\n")
-            lines.insert(e.begin + 1, "    { int in = -1, out = -1; const char* fds = std::getenv(\"BOXES_JUDGE_FDS\");"
-                                      " if (fds && std::sscanf(fds, \"%d,%d\", &in, &out) == 2) " + code + " }")
+            for e in sorted(items, key=lambda e: -e.begin):  # from the end: the line numbers hold
+                lines.insert(e.begin + 1, "    { int in = -1, out = -1; const char* fds = std::getenv(\"BOXES_JUDGE_FDS\");"
+                                          " if (fds && std::sscanf(fds, \"%d,%d\", &in, &out) == 2) {" + GARBAGE[e.id] +
+                                          " usleep(200000); } }")
             with open(path, "w", encoding="utf-8") as f:
                 f.write("#include <unistd.h>\n#include <cstdint>\n#include <cstdio>\n#include <cstdlib>\n"
                         "#include <cstring>\n" + "\n".join(lines))

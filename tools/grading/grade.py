@@ -77,7 +77,7 @@ class GradeOptions:
     hidden: str = None  # folder of hidden doctest files stepNN*.cpp
     junit: str = None  # the JUnit XML file (None: WORK/grade.xml)
     json: str = None  # the per-exercise JSON file (None: none)
-    timeout: float = 60.0  # seconds of one test case, wall clock
+    timeout: float = 60.0  # CPU seconds of one test case's worker (judge.case_limits: wall 3x)
     memory: int = 2048  # MB of address space of a test process
     output: float = 16.0  # MB printed, and of any file a test writes
     build_timeout: float = 900.0  # seconds of one step's build
@@ -352,7 +352,8 @@ def main(argv):
     p.add_argument("--junit", help="JUnit XML file to write (default WORK/grade.xml)")
     p.add_argument("--json", help="also write the per-exercise results as JSON to this file")
     p.add_argument("--timeout", type=decimal(0, MAX_SECONDS), default=defaults.timeout,
-                   help="time limit of one test case in seconds, wall clock (default %(default)g)")
+                   help="time limit of one test case in seconds: CPU time of the student's code, "
+                        "three times that on the wall clock (default %(default)g)")
     p.add_argument("--memory", type=integer(1, MAX_MB), default=defaults.memory,
                    help="memory limit of a test process in MB, address space (default %(default)d)")
     p.add_argument("--output", type=decimal(0, MAX_MB), default=defaults.output,

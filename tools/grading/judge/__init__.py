@@ -484,6 +484,29 @@ class Runner:
     judge_folder: str  # the checkers' folder: no worker sees it
 
 
+# A case's time limit is the CPU time of its worker (the student's code), as in IOI's and
+# DOMjudge's judges; its wall clock may run WALL_FACTOR times as long. A case makes up to a
+# few hundred thousand calls between checker and worker, each a wake-up of the other
+# process: on a loaded machine the scheduler's delays, not the student's code, would
+# otherwise decide the verdict. A worker that sleeps or waits still meets the wall clock.
+WALL_FACTOR = 3.0
+
+
+def case_limits(iso):
+    """The worker's limits of one case (or probe): CPU seconds the test time limit, the wall
+    clock WALL_FACTOR times it, both within the grading run's deadline."""
+    from ..errors import OutOfTime
+
+    limits = iso.test
+    wall = limits.seconds * WALL_FACTOR
+    if iso.deadline is not None:
+        left = iso.deadline - time.monotonic()
+        if left <= 0:
+            raise OutOfTime()
+        wall = min(wall, left)
+    return dataclasses.replace(limits, seconds=wall, cpu=min(limits.seconds, wall))
+
+
 def run_case(runner, checker, case, worker_binary, folder_name):
     """(status, reason, seconds) of one case: a fresh checker and a fresh worker."""
     from ..box import clean_env
@@ -491,15 +514,10 @@ def run_case(runner, checker, case, worker_binary, folder_name):
     from ..errors import OutOfTime
 
     iso = runner.iso
-    limits = iso.test
-    if iso.deadline is not None:
-        left = iso.deadline - time.monotonic()
-        if left <= 0:
-            raise OutOfTime()
-        limits = dataclasses.replace(limits, seconds=min(limits.seconds, left))
+    limits = case_limits(iso)
     # The checker waits on its worker: a little longer, so that a worker past its limit is
     # the reason, not the checker that waited for it.
-    checker_limits = dataclasses.replace(limits, seconds=limits.seconds + 2)
+    checker_limits = dataclasses.replace(limits, seconds=limits.seconds + 2, cpu=0.0)
     wfolder = os.path.join(runner.scratch, folder_name)
     cfolder = os.path.join(runner.private, folder_name)
     os.makedirs(wfolder)
@@ -610,12 +628,7 @@ def probe(runner, worker_binary, folder_name):
     from ..errors import OutOfTime
 
     iso = runner.iso
-    limits = iso.test
-    if iso.deadline is not None:
-        left = iso.deadline - time.monotonic()
-        if left <= 0:
-            raise OutOfTime()
-        limits = dataclasses.replace(limits, seconds=min(limits.seconds, left))
+    limits = case_limits(iso)
     wfolder = os.path.join(runner.scratch, folder_name)
     os.makedirs(wfolder)
     if iso.drop:

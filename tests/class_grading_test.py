@@ -609,17 +609,18 @@ CONTROL = "\\x1b[31mred\\x1b[0m bell\\x07 nul-free \\x01\\x02 del\\x7f nonchar\\
 
 def scenario_gradescope_control(work):
     """Prints control characters (and bytes that are no UTF-8) on stdout and stderr, then
-    ends before doctest writes a result, so its last line of stderr is the reason; then
-    the same tree by ./workbook grade as that user, whose JUnit XML must parse."""
+    throws them: the exception's message is the reason the checker reports (what the worker
+    prints reaches no result); then the same tree by ./workbook grade as that user, whose
+    JUnit XML must parse."""
     if os.geteuid() != 0:
         return SKIPPED
     files, hostile = hostile_files(body=[
         f'std::fputs("{CONTROL}\\n", stdout);',
         f'std::fputs("{CONTROL}\\n", stderr);',
         "std::fflush(nullptr);",
-        "std::_Exit(3);"])
+        f'throw std::runtime_error("{CONTROL}");'])
     doc = gradescope_root_run(work, files, "control")
-    expect_points(doc, "control", hostile, "no test result, exit 3")
+    expect_points(doc, "control", hostile, "threw")
     out = next((t["output"] for t in doc.get("tests", []) if t.get("number") == hostile), "")
     check("\\x1b[31mred" in out and "\\x07" in out, f"control: written out, not raw: {out[-300:]!r}")
     # The grader itself, in the bundle's tree (the one the user cannot read), with JUnit XML.

@@ -462,7 +462,10 @@ def scenario_hostile(work, kind):
             results = {x["exercise"]: x for x in json.load(f)["exercises"]}
     check(sorted(results) == sorted(ids), f"{kind}: the report has every exercise of step {first}")
     got = results.get(hostile.id, {})
-    check(got.get("points") == 0 and got.get("status") == want_status and want_text in got.get("reason", ""),
+    # The reason is the first failing case's; what the hostile code did may show in a later
+    # case's line (the first may be one that words its failure its own way).
+    said = "\n".join([got.get("reason", "")] + got.get("details", []))
+    check(got.get("points") == 0 and got.get("status") == want_status and want_text in said,
           f"{kind}: exercise {hostile.id} scores 0: {got.get('status')!r}, {got.get('reason', '')[:300]!r}")
     lines = {l.split()[0]: l for l in r.stdout.splitlines() if l[:1].isdigit()}
     check(want_text.split(":")[0] in lines.get(hostile.id, ""), f"{kind}: the table says why: {lines.get(hostile.id)!r}")
@@ -488,15 +491,15 @@ def scenario_hostile(work, kind):
             check(after[1][p] == data, f"{kind}: {os.path.relpath(p, work)} did not change")
     if kind == "read":
         for p in secret_paths(work):
-            check(f"cannot read {p} (No such file or directory)" in got.get("reason", ""),
+            check(f"cannot read {p} (No such file or directory)" in said,
                   f"{kind}: {p} is not there for the student's code")
     if kind == "files":
-        check("wrote /tmp/" in got.get("reason", ""), f"{kind}: the private /tmp was writable (and is gone)")
+        check("wrote /tmp/" in said, f"{kind}: the private /tmp was writable (and is gone)")
         # Every other place refused the write with its error (not there, not the sandbox's
         # user's, or read-only): none of them was written.
         for p in hostile_paths(token, work):
             if not p.startswith("/tmp/"):
-                check(f"{p}: " in got.get("reason", "") and f"wrote {p}" not in got.get("reason", ""),
+                check(f"{p}: " in said and f"wrote {p}" not in said,
                       f"{kind}: writing {p} was refused")
     try:
         connection, _ = listener.accept()

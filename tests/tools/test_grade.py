@@ -110,7 +110,8 @@ class PointsTable(unittest.TestCase):
         self.assertEqual((doc["points"], doc["max"], doc["seconds"], doc["notes"]), (1, 10, 12.35, ["n"]))
         self.assertEqual(doc["exercises"][1], {"exercise": "1.2", "title": "a root", "step": "01", "points": 0,
                                                "max": 2, "status": "failed", "reason": "failed: CHECK( x )",
-                                               "case": "edge", "hidden": 0, "seconds": 0.75})
+                                               "case": "edge", "details": ["passed: fine", "FAILED: edge: failed: CHECK( x )"],
+                                               "hidden": 0, "seconds": 0.75})
         grade_report.write_junit(os.path.join(folder, "g.xml"), rows, ["n"], 12.3)
         root = ET.parse(os.path.join(folder, "g.xml")).getroot()
         self.assertEqual((root.get("tests"), root.get("failures")), ("4", "3"))

@@ -121,14 +121,15 @@ def write_json(path, rows, notes, seconds):
     """The per-exercise results as JSON, for batch grading and other tools: one object per
     exercise with its points earned (0 unless passed), max, status (passed, failed, time
     limit, memory limit, output limit, crashed, does not compile, no tests), reason (empty
-    when passed), the first failing test case, hidden (how many of its cases are the
-    instructor's hidden tests) and seconds."""
+    when passed), the first failing test case, details (a line per test case: how it went),
+    hidden (how many of its cases are the instructor's hidden tests) and seconds."""
     doc = {"points": sum(r["points"] for r in rows if r["passed"]),
            "max": sum(r["points"] for r in rows), "seconds": round(seconds, 2),
            "exercises": [{"exercise": r["id"], "title": r["title"], "step": r["step"],
                           "points": r["points"] if r["passed"] else 0, "max": r["points"],
                           "status": r["status"], "reason": r["reason"], "case": r["case"],
-                          "hidden": r.get("hidden", 0), "seconds": round(r["seconds"], 2)}
+                          "details": list(r["details"]), "hidden": r.get("hidden", 0),
+                          "seconds": round(r["seconds"], 2)}
                          for r in rows],
            "notes": list(notes)}
     os.makedirs(os.path.dirname(os.path.abspath(path)), exist_ok=True)

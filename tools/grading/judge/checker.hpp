@@ -33,12 +33,34 @@ constexpr const char* variantOf() {
         static_assert(sizeof(T) == 0, "the grader's calls know float, double and long double");
 }
 
+// A message from the worker as the checker may report it: printable ASCII, every other byte
+// written \xNN (a control character or a byte that is no UTF-8 would make the checker's XML
+// result unreadable, and the case's reason "no test result"), at most kMaxMessage bytes.
+inline std::string printableMessage(const std::string& text) {
+    constexpr size_t kMaxMessage = 2000;
+    std::string out;
+    for (unsigned char c : text) {
+        if (out.size() >= kMaxMessage) {
+            out += "...";
+            break;
+        }
+        if (c >= 0x20 && c < 0x7f) {
+            out += char(c);
+        } else {
+            char escaped[8];
+            std::snprintf(escaped, sizeof escaped, "\\x%02x", c);
+            out += escaped;
+        }
+    }
+    return out;
+}
+
 [[noreturn]] inline void rethrowRemote(Reader& r) {
     auto kind = ErrorKind(r.pod<uint8_t>());
-    std::string what = r.text();
+    std::string what = printableMessage(r.text());
     switch (kind) {
         case ErrorKind::NotImplemented:
-            throw NotImplemented(r.text());
+            throw NotImplemented(printableMessage(r.text()));
         case ErrorKind::InvalidArgument:
             throw std::invalid_argument(what);
         case ErrorKind::DomainError:

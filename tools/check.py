@@ -31,6 +31,7 @@ import sys
 import tempfile
 import time
 import xml.etree.ElementTree as ET
+from collections import Counter
 
 from . import build as building
 from .grading import ROOT
@@ -182,10 +183,32 @@ def parse_cases(data):
             failure = None
             if not passed:
                 failure = first_failure(case)
-            cases.append({"suite": suite.get("name", ""), "name": case.get("name", ""),
+            name = case.get("name", "")
+            cases.append({"suite": suite.get("name", ""), "name": name,
                           "file": case.get("filename", ""),
-                          "line": case.get("line", ""), "passed": passed, "failure": failure})
+                          "line": case.get("line", ""), "passed": passed, "failure": failure,
+                          "checks": [] if passed else failed_checks(case, name)})
     return cases
+
+
+def failed_checks(case, name):
+    """What failed in a test case, as keys a failure each: "case | the check's expression"
+    (its text as written: the same check fails alike for the same mistake), and beside it
+    "case | expression | what the check's INFO said" when it said something (which face,
+    which ray); "case | threw" for an exception, "case | message" for a FAIL."""
+    found = []
+    for el in case.iter():
+        if el.tag == "Expression" and el.get("success") == "false":
+            key = f"{name} | {_text(el, 'Original')}"
+            found.append(key)
+            infos = [" ".join(i.text.split()) for i in el.findall("Info") if i.text]
+            if infos:
+                found.append(f"{key} | {'; '.join(infos)}")
+        elif el.tag == "Exception":
+            found.append(f"{name} | threw")
+        elif el.tag == "Message" and el.get("type", "").upper() in ("FAIL", "FAIL_CHECK", "ERROR"):
+            found.append(f"{name} | {_text(el, 'Text')}")
+    return found
 
 
 def first_failure(case):
@@ -230,21 +253,24 @@ def classify(exercise_id, cases, mistakes=None):
 
 def mistake_case(exercise_id, failing, mistakes):
     """Of the failing cases catalogued as a mistake of this exercise (tests/hints/
-    mistakes.json), the one that names the mistake made: one mistake often fails several
-    cases (a wrong sign fails the worked examples too), so each entry lists the cases its
-    mistake fails ("fails", from tests/mutants), and the entry whose list is most like the
-    cases that failed wins (Jaccard similarity; the first in test order on a tie). An entry
-    without the list stands for its own case alone. None when no catalogued case failed."""
-    failed = {c["name"] for c in failing}
-    best, score = None, -1.0
+    mistakes.json), the one that names the mistake made. One mistake often fails several
+    catalogued cases (a wrong union fails the worked example and the slide's typo alike), so
+    each entry records what its mistake fails, check by check ("fails": {"case | check":
+    times}, written by tests/mutants/fails.py). The mistake named is the one that explains
+    most of what failed here (the share of these failures in its record), and of those the
+    most specific (the smallest record), then the first in test order. An entry without a
+    record stands for its own case's failures. None when no catalogued case failed."""
+    seen = Counter(key for c in failing for key in c.get("checks") or [f"{c['name']} | "])
+    best, rank = None, None
     for c in failing:
         m = (mistakes or {}).get(c["name"])
         if not isinstance(m, dict) or m.get("exercise") != exercise_id:
             continue
-        fails = set(m.get("fails") or []) | {c["name"]}
-        similarity = len(fails & failed) / len(fails | failed)
-        if similarity > score:
-            best, score = c, similarity
+        record = Counter(m.get("fails") or {}) or Counter(c.get("checks") or [f"{c['name']} | "])
+        explained = sum((record & seen).values()) / sum(seen.values())
+        candidate = (-explained, sum(record.values()))
+        if rank is None or candidate < rank:
+            best, rank = c, candidate
     return best
 
 

@@ -75,9 +75,13 @@ class Classify(unittest.TestCase):
         # them alone: the touching boxes' case names this mistake.
         cases = check.parse_cases(xml(case("worked examples", 1, FAILED_CHECK),
                                       case("touching boxes", 1, FAILED_CHECK), case("other")))
-        mistakes = {"worked examples": {"exercise": "1.4", "hint": "all axes"},
+        check_ = "!hit.has_value()"
+        info = "ray O (0, 0, -1) D (0.9, 0.9, 1)"
+        fails = lambda *names: {k: 1 for n in names for k in (f"{n} | {check_}", f"{n} | {check_} | {info}")}
+        mistakes = {"worked examples": {"exercise": "1.4", "hint": "all axes",
+                                        "fails": fails("worked examples")},
                     "touching boxes": {"exercise": "1.4", "hint": "compare with <=",
-                                       "fails": ["worked examples", "touching boxes"]}}
+                                       "fails": fails("worked examples", "touching boxes")}}
         status, shown = check.classify("1.4", cases, mistakes)
         self.assertEqual(shown["name"], "touching boxes")
         self.assertEqual(check.hint_for({"id": "1.4", "status": status, "case": shown}, ({}, mistakes)),

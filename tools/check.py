@@ -34,7 +34,7 @@ import xml.etree.ElementTree as ET
 from collections import Counter
 
 from . import build as building
-from .grading import ROOT
+from . import ROOT
 from .grading.exercises import MAX_RESULT_BYTES, exercises as marked_exercises, step_dirs
 
 # The student's own build (preset student: the grader's -O1, no link-time optimisation, the

@@ -1,10 +1,10 @@
-#!/usr/bin/python3
 """Records what each catalogued mistake fails, check by check, in its entry of
 tests/hints/mistakes.json ("fails": {"test case | the check's expression": times}).
 `./workbook check` names the mistake a student made from these records: of the catalogued
 cases that fail, the one whose mistake fails most alike (tools/check.py mistake_case).
 
-usage: tests/mutants/fails.py [N.M | NN | N.M-name ...]   (in the reference tree; default: all)
+usage: python3 -m tests.mutants.fails [N.M | NN | N.M-name ...]
+       (from the reference tree's root; default: every mistake)
 
 Each mistake (tests/mutants/N.M-name.patch) is applied to the mutants' private copy of the
 tree (build/mutants/tree, tools/grading/mutants.py), the exercise's test program built,
@@ -17,11 +17,10 @@ import os
 import sys
 from collections import Counter
 
-ROOT = os.path.dirname(os.path.dirname(os.path.dirname(os.path.abspath(__file__))))
-sys.path.insert(0, ROOT)  # the tools package, imported from the repository root
-from tools import build as building  # noqa: E402
-from tools.check import parse_cases, run_suite  # noqa: E402
-from tools.grading import mutants  # noqa: E402
+from tools import ROOT
+from tools import build as building
+from tools.check import parse_cases, run_suite
+from tools.grading import mutants
 
 HINTS = os.path.join(ROOT, "tests", "hints", "mistakes.json")
 

@@ -1,4 +1,3 @@
-#!/usr/bin/python3
 """The student's time: how long the workbook's own commands make a student wait, measured
 as a student meets them, in a fresh kit and a fresh clone.
 
@@ -40,7 +39,8 @@ import tempfile
 import threading
 import time
 
-ROOT = os.path.dirname(os.path.dirname(os.path.dirname(os.path.abspath(__file__))))
+from tools import ROOT
+from tools.grading.kit import tracked_files
 
 # (row, what the student does, target seconds)
 TARGETS = [
@@ -132,9 +132,6 @@ def fresh_clone(source, dest, rev=None):
         if rev:
             subprocess.run(["git", "-C", dest, "checkout", "--quiet", rev], check=True)
         return dest
-    sys.path.insert(0, source)
-    from tools.grading.kit import tracked_files  # noqa: PLC0415 (a kit has kit.py too)
-
     for rel in tracked_files(source):
         os.makedirs(os.path.dirname(os.path.join(dest, rel)), exist_ok=True)
         shutil.copy2(os.path.join(source, rel), os.path.join(dest, rel))

@@ -7,8 +7,9 @@ usage: python3 -m tests.mutants.fails [N.M | NN | N.M-name ...]
        (from the reference tree's root; default: every mistake)
 
 Each mistake (tests/mutants/N.M-name.patch) is applied to the mutants' private copy of the
-tree (build/mutants/tree, tools/grading/mutants.py), the exercise's test program built,
-its suite run as check runs it (doctest's XML), and the patch taken back. Run it after a
+tree (build/mutants/tree, tools/grading/mutants.py), the exercise's test program built
+there with check's preset (student), its suite run as check runs it (doctest's XML), and
+the patch taken back. Run it after a
 change to an exercise's tests or to a patch; a mistake that its own case does not catch is
 reported and its record left as it was.
 """
@@ -25,7 +26,7 @@ from tools.grading import mutants
 HINTS = os.path.join(ROOT, "tests", "hints", "mistakes.json")
 
 
-def failures(tree, mutant, log):
+def failures(tree, target, mutant, log):
     """{"case | check": times} of the mutant's exercise, or raises RuntimeError saying why."""
     with open(mutants.applied_marker(tree), "w", encoding="utf-8") as f:
         f.write(mutant.path)
@@ -34,7 +35,6 @@ def failures(tree, mutant, log):
         os.remove(mutants.applied_marker(tree))
         raise RuntimeError(f"does not apply: {r.stderr.strip()}")
     try:
-        target = building.Tree(tree, mutants.build_dir(tree))
         b = building.build(target, [f"test_step{mutant.step:02d}"], jobs=2, log=log)
         if not b.ok:
             raise RuntimeError(f"does not build: {b.error}")
@@ -58,12 +58,14 @@ def main(argv):
     tree = mutants.private_tree()
     problems = 0
     with open(os.path.join(ROOT, "build", "mutants", "fails-log.txt"), "w", encoding="utf-8") as log:
-        if not mutants.configure(tree, log):
+        # The student's preset, as check builds: the same flags, the same failures.
+        target = building.Tree.of_preset(tree, "student")
+        if not building.configure(target, log=log).ok:
             print("fails: configuring the private tree failed (build/mutants/fails-log.txt)", file=sys.stderr)
             return 1
         for i, m in enumerate(chosen):
             try:
-                found = failures(tree, m, log)
+                found = failures(tree, target, m, log)
             except RuntimeError as e:
                 print(f"[fails] {m.id}: {e}", file=sys.stderr)
                 problems += 1

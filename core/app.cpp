@@ -1,5 +1,6 @@
 #include "core/app.hpp"
 
+#include <CLI/CLI.hpp>
 #include <charconv>
 #include <cmath>
 #include <cstdlib>

@@ -3,7 +3,6 @@
 // shell's (core/step.hpp).
 #pragma once
 
-#include <CLI/CLI.hpp>
 #include <functional>
 #include <optional>
 #include <string>
@@ -11,6 +10,14 @@
 
 #include "core/render.hpp"
 #include "core/scene.hpp"
+
+// CLI11 declared, not included: <CLI/CLI.hpp> costs a file about 9 s of compile time (its
+// parser and the code of its global validators), and most files that include this header
+// never build a command line. Those that do include it themselves.
+namespace CLI {
+class App;
+class Option;
+}  // namespace CLI
 
 namespace boxes {
 

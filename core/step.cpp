@@ -1,5 +1,6 @@
 #include "core/step.hpp"
 
+#include <CLI/CLI.hpp>
 #include <chrono>
 #include <iostream>
 

@@ -6,7 +6,6 @@
 // every step program.
 #pragma once
 
-#include <CLI/CLI.hpp>
 #include <functional>
 #include <optional>
 #include <string>

@@ -3,6 +3,7 @@
 // the lecture's example exam, scored per part at the end, and its printable sheet.
 #include <unistd.h>
 
+#include <CLI/CLI.hpp>
 #include <algorithm>
 #include <filesystem>
 #include <fstream>

@@ -3,6 +3,7 @@
 // list, one argument per line. Promise: a scene with a valid camera and sizes in range, or
 // one of the errors runMain turns into one line and an exit code (UsageError, InputError,
 // std::invalid_argument, ExitRequest for --help); never another exception or a crash.
+#include <CLI/CLI.hpp>
 #include <sstream>
 #include <vector>
 

@@ -6,27 +6,33 @@ usage: python3 -m tests.check_test WORK_DIR [BUILD_DIR]
   BUILD_DIR: this tree's release build, whose step 01 program renders the kit's reference
   pictures (default build/release)
 
-One kit, one build of step 01 in it, the cases in order:
-  fresh        `check 01`: 0 points, every exercise "not started", the next one is 1.1 with
-               its file and line (the line of its EXERCISE marker)
+One kit, one build in it (check's own, build/student), the cases in order:
+  fresh        `check`: 0 points, every exercise of step 01 "not started", the later steps
+               not checked, the next one is 1.1 with its file and line (the line of its
+               EXERCISE marker); only step 01's test program and what it needs were built
+  hang         exercise 1.1 that never returns: one "timed out" verdict, no picture render
   correct 1.4  the reference's 1.4 copied into the kit: `check 1.4` passes, and its picture
                is the reference's
   wrong 1.4    the catalogued mistake without the u + v > 1 rejection: `check 1.4` fails,
                names the mistake's test case, `--hint` gives the mistake's hint, and
                out/check/1.4.png marks the extra pixels (as many as it says)
+  hints        three mistakes that fail more than their own case (2.1 with the sign of d
+               flipped on the negative faces, 3.4 with the slide's bmin.y typo, 3.5 with
+               strict comparisons): `--hint` names each one's own mistake
   watch        `check 1.4 --watch`: an edit (the mistake fixed) starts a new run within two
                seconds, and that run passes; by polling too when inotifywait is installed
 
-Only step 01 is built (check builds the steps it checks), so the kit costs one build of the
-core and step 01, at -O1 as the grader builds. The kit is written anew each run (a fresh
-kit), in WORK_DIR/kit.
+check builds the steps it checks (01, then 02 and 03 for the hints) at the grader's -O1.
+The kit is written anew each run (a fresh kit), in WORK_DIR/kit.
 """
+import json
 import os
 import re
 import shutil
 import signal
 import subprocess
 import sys
+import tempfile
 import threading
 import time
 
@@ -40,6 +46,24 @@ from tools.pictures import HEIGHT, MARK, WIDTH, render_references
 
 EXERCISE = "1.4"
 MISTAKE = os.path.join(ROOT, "tests", "mutants", "1.4-no-uv-sum-rejection.patch")
+# Mistakes whose own test case is not the first one they fail: (exercise, the patch's text
+# or a catalogued patch, the test case whose hint names the mistake). The first is not in
+# the catalogue (whose cases each catch one mistake): the sign of d flipped on the negative
+# faces only fails the same cases as 2.1-half-extent-sign, and must get its hint.
+NEGATIVE_FACES_D = """--- a/steps/02_box/box.cpp
++++ b/steps/02_box/box.cpp
+@@ -49,3 +49,4 @@
+         Vec3T<T> n = sign * box.axes[size_t(axis)];
+-        planes[size_t(face)] = PlaneT<T>{n, -(glm::dot(n, box.centre) + box.halfExtents[axis])};
++        T d = glm::dot(n, box.centre) + box.halfExtents[axis];
++        planes[size_t(face)] = PlaneT<T>{n, sign * -d};
+     }
+"""
+HINT_CASES = [
+    ("2.1", NEGATIVE_FACES_D, "face planes: every face passes through the centre plus or minus its half extent"),
+    ("3.4", os.path.join(ROOT, "tests", "mutants", "3.4-slide-y-line.patch"), None),
+    ("3.5", os.path.join(ROOT, "tests", "mutants", "3.5-strict.patch"), None),
+]
 WATCH_LIMIT = 2.0  # seconds from a save to the new run
 
 failures = []
@@ -88,9 +112,23 @@ def marked(composite):
                        for x in range(start, start + WIDTH))
 
 
+def built_outputs(kit):
+    """What the kit's build has built so far (ninja's log), as paths in the build folder."""
+    path = os.path.join(kit, "build", "student", ".ninja_log")
+    with open(path, encoding="utf-8") as f:
+        return {line.split("\t")[3] for line in f if not line.startswith("#") and line.count("\t") >= 4}
+
+
+def needed_for(kit, target, output):
+    """The target, its output file and everything ninja builds it from."""
+    r = subprocess.run(["ninja", "-C", os.path.join(kit, "build", "student"), "-t", "inputs", target],
+                       capture_output=True, text=True)
+    return set(r.stdout.split()) | {output}
+
+
 def case_fresh(kit, ex):
     step = [e for e in ex if e.step == 1]
-    rc, out = run_check(kit, "01")
+    rc, out = run_check(kit)
     check(rc == 0, f"fresh kit: check 01 exits 0 (nothing attempted), exit {rc}")
     total = sum(e.points for e in step)
     check(re.search(rf"^  total\s+0/{total}\s+points", out, re.M) is not None, f"fresh kit: 0 of {total} points")
@@ -105,6 +143,68 @@ def case_fresh(kit, ex):
         n = int(m.group(2))
         where_ok = 1 <= n <= len(lines) and f"EXERCISE {first.id}:" in lines[n - 1]
     check(where_ok, f"fresh kit: the file and line given hold exercise {first.id}'s marker ({m and m.group(0).strip()})")
+    later = sum(e.points for e in ex if e.step > 1)
+    check(re.search(r"^  \S+: not checked yet \(\d+ exercises of steps 02", out, re.M) is not None,
+          "fresh kit: the later steps are not checked yet, and the table says so")
+    # Step 01's tests, then (after the verdict) step 01's program for the pictures; ninja's
+    # bookkeeping (build.ninja, CMake's check of its globs) besides.
+    allowed = needed_for(kit, "test_step01", "tests/test_step01") | \
+        needed_for(kit, "01_triangle", "steps/01_triangle/01_triangle") | \
+        {"build.ninja", os.path.join(kit, "build", "student", "CMakeFiles", "cmake.verify_globs")}
+    extra = sorted(built_outputs(kit) - allowed)
+    check(not extra and later > 0,
+          f"fresh kit: only step 01's test program, its program and what they need were built ({extra[:5]})")
+
+
+def case_hang(kit, ex):
+    """Exercise 1.1 never returns: its tests time out once, and no picture is rendered."""
+    e = next(x for x in ex if x.id == "1.1")
+    path = os.path.join(kit, e.path)
+    with open(path, encoding="utf-8") as f:
+        stub = f.read()
+    loop = stub.replace('throw NotImplemented("1.1");', "for (volatile int spin = 0;; spin = spin + 0) {\n    }", 1)
+    check(loop != stub, "hang: exercise 1.1's stub is replaced by a loop")
+    with open(path, "w", encoding="utf-8") as f:
+        f.write(loop)
+    try:
+        rc, out = run_check(kit, "1.1")
+    finally:
+        with open(path, "w", encoding="utf-8") as f:
+            f.write(stub)
+    check(rc == 1 and "timed out" in row(out, "1.1"), f"hang: 1.1 timed out ({row(out, '1.1')})")
+    check(out.count("timed out:") == 1, "hang: one verdict, once")
+    check("[check] rendering" not in out and "its picture is not rendered" in out,
+          "hang: no picture is rendered for it, and check says so")
+
+
+def case_hints(kit, ex):
+    """Each mistake's own hint, though it fails other catalogued cases first."""
+    with open(os.path.join(ROOT, "tests", "hints", "mistakes.json"), encoding="utf-8") as f:
+        hints = json.load(f)
+    for exercise_id, patch, case in HINT_CASES:
+        e = next(x for x in ex if x.id == exercise_id)
+        path = os.path.join(kit, e.path)
+        with open(path, encoding="utf-8") as f:
+            stub = f.read()
+        solve(kit, e)
+        if os.path.isfile(patch):
+            case = read_mutant(patch).caught_by
+        else:
+            with tempfile.NamedTemporaryFile("w", suffix=".patch", dir=kit, delete=False) as f:
+                f.write(patch)
+            patch = f.name
+        r = git_apply(kit, patch)
+        check(r.returncode == 0, f"hint {exercise_id}: the mistake applies to the kit ({r.stderr.strip()})")
+        try:
+            rc, out = run_check(kit, exercise_id, "--hint", "--no-pictures")
+        finally:
+            with open(path, "w", encoding="utf-8") as f:
+                f.write(stub)
+            if patch.startswith(kit):
+                os.remove(patch)
+        want = hints[case]["hint"]
+        check(rc == 1 and f'failing test case: "{case}"' in out and f"hint (this mistake): {want}" in out,
+              f"hint {exercise_id}: the case and hint of the mistake made: {case!r}")
 
 
 def case_correct(kit, exercise):
@@ -205,16 +305,13 @@ def main():
     print(f"kit written with step 01's reference pictures: {time.monotonic() - started:.1f} s", flush=True)
     ex = exercises(ROOT)
     exercise = next(e for e in ex if e.id == EXERCISE)
-    # -O1, as the grader builds: a cheaper build of the same code (no -ffast-math, so the
-    # pictures are the same); check configures a kit that has no build itself.
-    r = subprocess.run(["cmake", "--preset", "release", "-DCMAKE_CXX_FLAGS_RELEASE=-O1 -DNDEBUG"],
-                       cwd=kit, capture_output=True, text=True)
-    check(r.returncode == 0, f"the kit configures ({r.stderr.strip()[-300:]})")
     case_fresh(kit, ex)
+    case_hang(kit, ex)
     case_correct(kit, exercise)
     with open(os.path.join(kit, exercise.path), encoding="utf-8") as f:
         correct_text = f.read()
     case_wrong(kit, exercise)
+    case_hints(kit, ex)
     case_watch(kit, exercise, correct_text, poll=False)
     if shutil.which("inotifywait"):
         git_apply(kit, MISTAKE)

@@ -1,5 +1,6 @@
 // Reliability hard cases of the command line: user text quoted on one line, and every
 // number on a command line read exactly, in-process and by every step program.
+#include <CLI/CLI.hpp>
 #include <filesystem>
 #include <fstream>
 #include <sstream>

@@ -166,8 +166,10 @@ TEST_SUITE("exercise 2.1") {
 }
 
 TEST_SUITE("exercise 2.1") {
-    // The box with centre (1, 2, 3), half extents (1, 2, 3) along x, y and z.
-    const OrientedBoxd kBox = OrientedBoxd::axisAligned(Bounds3d({0, 0, 0}, {2, 4, 6}));
+    // The box with centre (1.5, 1, 7), half extents (1, 2, 3) along x, y and z. No face
+    // passes through the origin: there d = 0 whatever its sign, and a wrong sign of d on
+    // the negative faces would go unseen.
+    const OrientedBoxd kBox = OrientedBoxd::axisAligned(Bounds3d({0.5, -1, 4}, {2.5, 3, 10}));
     TEST_CASE("face planes: every face passes through the centre plus or minus its half extent") {
         auto p = boxFacePlanes(kBox);
         for (int f = 0; f < 6; ++f) {

@@ -1,21 +1,24 @@
-"""The student's loop: build what changed, run the exercises' tests in order, show a table of
-points and, for the first exercise that does not pass, what failed, where, and a hint; with
-pictures of the student's render beside the reference (tools/pictures.py).
+"""The student's loop: build what the next verdict needs, run the exercises' tests in order,
+show a table of points and, for the first exercise that does not pass, what failed, where,
+and a hint; then pictures of the student's render beside the reference (tools/pictures.py).
 
-usage: ./workbook check [N.M | NN ...] [--hint] [--watch] [--timeout S] [--no-pictures]
+usage: ./workbook check [N.M | NN ...] [--all] [--hint] [--watch] [--timeout S] [--no-pictures]
        (python3 -m tools.check ..., from the tree's root; in the full tree and a starter kit)
 
-  (nothing)   every exercise          N.M   one exercise        NN   one step's exercises
+  (nothing)   the exercises in order, up to the step of the first one that does not pass
+  --all       every exercise     N.M   one exercise        NN   one step's exercises
   --hint      the hint for the first exercise that does not pass (tests/hints/)
   --watch     run again whenever a file under steps/ changes (inotifywait, or polling)
-  --timeout S the time limit of one exercise's tests (default 60 s)
+  --timeout S the time limit of one exercise's tests (default 10 s)
 
-An exercise is "not started" while its body is the kit's stub (it throws NotImplemented
-with its own number), "needs N.M" when its tests stop at another exercise's stub, "passed"
-when every test case passes, "failed" otherwise; "crashed", "timed out" and "does not
-compile" say so. Exit 0 when every exercise that was attempted passes, 1 otherwise, 2 for a
-bad command line. Results go to out/check/status.json (the tour's report reads it) and the
-pictures to out/check/N.M.png.
+It builds in build/student (preset student: the grader's flags, -O1): a step's test program
+before its verdict, the step's program for the pictures after it. An exercise is "not
+started" while its body is the kit's stub (it throws NotImplemented with its own number),
+"needs N.M" when its tests stop at another exercise's stub, "passed" when every test case
+passes, "failed" otherwise; "crashed", "timed out" and "does not compile" say so. Exit 0
+when every exercise that was attempted passes, 1 otherwise, 2 for a bad command line.
+Results go to out/check/status.json (the tour's report reads it) and the pictures to
+out/check/N.M.png.
 """
 import argparse
 import json
@@ -28,18 +31,24 @@ import sys
 import tempfile
 import time
 import xml.etree.ElementTree as ET
+from collections import Counter
 
 from . import build as building
-from .grading import ROOT
+from . import ROOT
 from .grading.exercises import MAX_RESULT_BYTES, exercises as marked_exercises, step_dirs
 
-BUILD = os.path.join("build", "release")
+# The student's own build (preset student: the grader's -O1, no link-time optimisation, the
+# step programs built only for the pictures, after the verdict).
+PRESET = "student"
+BUILD = os.path.join("build", PRESET)
 OUT = os.path.join("out", "check")
 HINTS = os.path.join("tests", "hints")
 NOT_IMPLEMENTED = re.compile(r"exercise (\d+\.\d+) is not implemented yet")
 # What a stub throws (core/exercise.hpp), shown when a test reports it.
 STATUS_ORDER = ("passed", "failed", "crashed", "timed out", "does not compile", "needs",
-                "not started", "no tests")
+                "not started", "no tests", "not checked")
+# An exercise's tests run in well under a second: a limit of seconds finds a loop at once.
+EXERCISE_TIMEOUT = 10.0
 
 
 def say(text=""):
@@ -85,7 +94,7 @@ def first_compile_error(output, root):
 
 
 def tree_of(root):
-    return building.Tree.of_preset(root, "release")
+    return building.Tree.of_preset(root, PRESET)
 
 
 def configure(root):
@@ -94,17 +103,23 @@ def configure(root):
     return None if r.ok else r.error
 
 
-def build_step(root, number, jobs=None):
-    """Builds the step's test program (and its program, for the pictures), saying how far it
-    has got; None or the first compile error."""
-    target = f"test_step{number:02d}"
-    say(f"[check] building step {number:02d} ({target} and what it needs; a first build takes minutes)")
-    r = building.build(tree_of(root), [target], jobs, progress=building.Progress("[check]", sys.stdout))
+def build_targets(root, targets, what, jobs=None):
+    """Builds the targets, saying so when there is something to build; None or the first
+    compile error."""
+    progress = building.Progress("[check]", sys.stdout)
+    r = building.build(tree_of(root), targets, jobs, progress=progress)
     if not r.ok:
         return r.error
     if r.steps:
-        say(f"[check]   {r.steps} build steps done in {r.seconds:.0f} s")
+        say(f"[check] built {what}: {r.steps} build steps in {r.seconds:.1f} s")
     return None
+
+
+def build_step(root, number, jobs=None):
+    """Builds the step's test program, and only that: its verdict needs nothing else (the
+    step's program, for the pictures, comes after the verdict). None or the first compile
+    error."""
+    return build_targets(root, [f"test_step{number:02d}"], f"step {number:02d}'s tests", jobs)
 
 
 # Running one exercise's tests -------------------------------------------------------------
@@ -168,10 +183,32 @@ def parse_cases(data):
             failure = None
             if not passed:
                 failure = first_failure(case)
-            cases.append({"suite": suite.get("name", ""), "name": case.get("name", ""),
+            name = case.get("name", "")
+            cases.append({"suite": suite.get("name", ""), "name": name,
                           "file": case.get("filename", ""),
-                          "line": case.get("line", ""), "passed": passed, "failure": failure})
+                          "line": case.get("line", ""), "passed": passed, "failure": failure,
+                          "checks": [] if passed else failed_checks(case, name)})
     return cases
+
+
+def failed_checks(case, name):
+    """What failed in a test case, as keys a failure each: "case | the check's expression"
+    (its text as written: the same check fails alike for the same mistake), and beside it
+    "case | expression | what the check's INFO said" when it said something (which face,
+    which ray); "case | threw" for an exception, "case | message" for a FAIL."""
+    found = []
+    for el in case.iter():
+        if el.tag == "Expression" and el.get("success") == "false":
+            key = f"{name} | {_text(el, 'Original')}"
+            found.append(key)
+            infos = [" ".join(i.text.split()) for i in el.findall("Info") if i.text]
+            if infos:
+                found.append(f"{key} | {'; '.join(infos)}")
+        elif el.tag == "Exception":
+            found.append(f"{name} | threw")
+        elif el.tag == "Message" and el.get("type", "").upper() in ("FAIL", "FAIL_CHECK", "ERROR"):
+            found.append(f"{name} | {_text(el, 'Text')}")
+    return found
 
 
 def first_failure(case):
@@ -193,9 +230,9 @@ def first_failure(case):
 
 
 def classify(exercise_id, cases, mistakes=None):
-    """(status, the failing case to show or None) for one exercise's test cases: the first
-    failing case, or the first that exists for a catalogued mistake of this exercise
-    (`mistakes`: tests/hints/mistakes.json), whose hint says more than the exercise's."""
+    """(status, the failing case to show or None) for one exercise's test cases: the case
+    that names the mistake (mistake_case) when a catalogued one failed, else the first
+    failing case."""
     if not cases:
         return "no tests", None
     failing = [c for c in cases if not c["passed"]]
@@ -210,9 +247,31 @@ def classify(exercise_id, cases, mistakes=None):
         return "not started", failing[missing.index(exercise_id)]
     real = [c for c, m in zip(failing, missing) if m is None]
     if real:
-        own = [c for c in real if (mistakes or {}).get(c["name"], {}).get("exercise") == exercise_id]
-        return "failed", (own or real)[0]
+        return "failed", mistake_case(exercise_id, real, mistakes) or real[0]
     return "needs " + ", ".join(sorted(set(missing), key=lambda s: tuple(map(int, s.split("."))))), failing[0]
+
+
+def mistake_case(exercise_id, failing, mistakes):
+    """Of the failing cases catalogued as a mistake of this exercise (tests/hints/
+    mistakes.json), the one that names the mistake made. One mistake often fails several
+    catalogued cases (a wrong union fails the worked example and the slide's typo alike), so
+    each entry records what its mistake fails, check by check ("fails": {"case | check":
+    times}, written by tests/mutants/fails.py). The mistake named is the one that explains
+    most of what failed here (the share of these failures in its record), and of those the
+    most specific (the smallest record), then the first in test order. An entry without a
+    record stands for its own case's failures. None when no catalogued case failed."""
+    seen = Counter(key for c in failing for key in c.get("checks") or [f"{c['name']} | "])
+    best, rank = None, None
+    for c in failing:
+        m = (mistakes or {}).get(c["name"])
+        if not isinstance(m, dict) or m.get("exercise") != exercise_id:
+            continue
+        record = Counter(m.get("fails") or {}) or Counter(c.get("checks") or [f"{c['name']} | "])
+        explained = sum((record & seen).values()) / sum(seen.values())
+        candidate = (-explained, sum(record.values()))
+        if rank is None or candidate < rank:
+            best, rank = c, candidate
+    return best
 
 
 def last_case_started(data):
@@ -236,11 +295,12 @@ def load_hints(root):
 
 
 def hint_for(row, hints):
-    """The mistake's hint when the failing test case is a catalogued mistake of this
-    exercise, else the exercise's hint."""
+    """(hint, whether it is the mistake's own): the hint of the case shown for a failed
+    exercise when that case is a catalogued mistake of the exercise, else the exercise's
+    hint (a not-started exercise, one that needs another, one that crashed or timed out)."""
     generic, mistakes = hints
     case = (row.get("case") or {}).get("name")
-    m = mistakes.get(case) if case else None
+    m = mistakes.get(case) if case and row.get("status", "failed") == "failed" else None
     if isinstance(m, dict) and m.get("hint") and m.get("exercise", row["id"]) == row["id"]:
         return m["hint"], True
     return generic.get(row["id"], ""), False
@@ -249,15 +309,24 @@ def hint_for(row, hints):
 # One run ----------------------------------------------------------------------------------
 
 
-def check_once(root, chosen, opts):
+def check_once(root, chosen, opts, in_order=False):
+    """One row per chosen exercise. in_order: the student's next exercise is what matters;
+    the steps after the first one with an exercise that does not pass are not built or run
+    (their rows say "not checked")."""
     rows, built = [], {}
     mistakes = load_hints(root)[1]
     problem = configure(root)
+    stop_after = None
     for e in chosen:
         row = {"id": e.id, "title": e.title, "points": e.points, "earned": 0, "step": e.step,
                "where": f"{e.path}:{e.marker_line + 1}", "case": None, "detail": "",
                "cases": 0, "failed": 0}
+        if in_order and stop_after is None and rows and rows[-1]["status"] != "passed":
+            stop_after = rows[-1]["step"]  # the step of the next exercise
         rows.append(row)
+        if stop_after is not None and e.step != stop_after:
+            row["status"] = "not checked"
+            continue
         if problem:
             row["status"], row["detail"] = "does not compile", problem
             continue
@@ -286,13 +355,16 @@ def check_once(root, chosen, opts):
 
 
 def attempted(row):
-    return not (row["status"] == "not started" or row["status"].startswith("needs"))
+    return not (row["status"] in ("not started", "not checked") or row["status"].startswith("needs"))
 
 
 def print_table(rows, everything):
     say()
     say(f"  {'exercise':<9}{'points':>7}  status")
+    later = [r for r in rows if r["status"] == "not checked"]
     for r in rows:
+        if r["status"] == "not checked":
+            continue
         status = r["status"]
         if status == "failed":
             status += f" ({r['failed']} of {r['cases']} test cases)"
@@ -301,8 +373,15 @@ def print_table(rows, everything):
         if len(status) > 90:
             status = status[:87] + "..."
         say(f"  {r['id']:<9}{str(r['earned']) + '/' + str(r['points']):>7}  {status}")
+    if later:
+        steps = sorted({r["step"] for r in later})
+        say(f"  {later[0]['id']}-{later[-1]['id']}: not checked yet ({len(later)} exercises of "
+            f"step{'s' if len(steps) > 1 else ''} {', '.join(f'{n:02d}' for n in steps)}; "
+            f"./workbook check --all checks them now)")
     earned, total = sum(r["earned"] for r in rows), sum(r["points"] for r in rows)
-    scope = "" if everything else " (the exercises checked)"
+    scope = "" if everything and not later else " (the exercises checked)"
+    if later:
+        total -= sum(r["points"] for r in later)
     say(f"  {'total':<9}{str(earned) + '/' + str(total):>7}  points{scope}")
     return earned, total
 
@@ -366,17 +445,11 @@ def _rel(where, root):
 
 
 def report(rows, root, opts, everything):
-    earned, total = print_table(rows, everything)
+    """The table and the next exercise (its verdict, the failure, the hint) first; then its
+    picture and the others', which may need the step's program built."""
+    print_table(rows, everything)
     hints = load_hints(root)
-    first = next((r for r in rows if r["status"] != "passed"), None)
-    from . import pictures  # noqa: PLC0415 (the pictures are optional; a failure there is said)
-
-    shown = {}
-    if not opts.no_pictures:
-        try:
-            shown = pictures.make(root, rows, first, os.path.join(root, OUT), say)
-        except Exception as exc:  # a picture must never hide the table
-            say(f"[check] the pictures failed: {exc}")
+    first = next((r for r in rows if r["status"] not in ("passed", "not checked")), None)
     say()
     if first is None:
         say("  Every exercise checked passes." + (" Well done." if everything else ""))
@@ -386,9 +459,6 @@ def report(rows, root, opts, everything):
         say(f"  where: {first['where']}")
         for line in describe_failure(first, root):
             say(line)
-        pic = shown.get(first["id"])
-        if pic:
-            say(f"  picture: {pic}")
         hint, specific = hint_for(first, hints)
         if opts.hint:
             if hint:
@@ -397,9 +467,51 @@ def report(rows, root, opts, everything):
                 say("  (no hint written for this exercise)")
         elif hint:
             say("  a hint: ./workbook check --hint" + (f" {first['id']}" if not everything else ""))
+    shown = {} if opts.no_pictures else make_pictures(root, rows, first, opts)
+    if first is not None and shown.get(first["id"]):
+        say(f"  picture: {shown[first['id']]}")
+    for r in rows:  # the other pictures this run made, or could not make
+        line = shown.get(r["id"]) or ""
+        if r is not first and line and not line.startswith("none:") and ": once the" not in line:
+            say(f"  picture of {r['id']}: {line}")
     write_status(root, rows, shown)
     failing = [r for r in rows if attempted(r) and r["status"] != "passed"]
     return 0 if not failing else 1
+
+
+# The pictures' run of the step's program would hang or crash the same way as its tests.
+NO_PICTURE = {"timed out": "its tests did not finish, so its picture is not rendered",
+              "crashed": "its tests crashed, so its picture is not rendered"}
+
+
+def make_pictures(root, rows, first, opts):
+    """{exercise: the picture line}: the step programs the pictures need are built first.
+    A picture not made in this run is removed from out/check/, so none is ever shown as
+    this run's when it is an older one."""
+    from . import pictures  # noqa: PLC0415 (the pictures are optional; a failure there is said)
+
+    shown = {r["id"]: f"none: {NO_PICTURE[r['status']]}" for r in rows if r["status"] in NO_PICTURE}
+    rows_drawn = [r for r in rows if r["id"] not in shown and r["status"] != "not checked"]
+    first_drawn = first if first is not None and first["id"] not in shown else None
+    wanted = [r for r in rows_drawn if r["status"] in ("passed", "failed") or r is first_drawn]
+    programs = sorted({pictures.program(root, BUILD, pic[1])[1] for pic in
+                       filter(None, (pictures.picture_of(r["id"]) for r in wanted))} - {None})
+    problem = build_targets(root, programs, "the pictures' programs", opts.jobs) if programs else None
+    if problem:
+        for r in wanted:
+            shown[r["id"]] = f"none: the step's program does not build ({problem})"
+    else:
+        try:
+            shown |= pictures.make(root, rows_drawn, first_drawn, os.path.join(root, OUT), say,
+                                   build=BUILD)
+        except Exception as exc:  # a picture must never hide the table
+            say(f"[check] the pictures failed: {exc}")
+    for r in rows:
+        path = os.path.join(root, OUT, f"{r['id']}.png")
+        fresh = os.path.relpath(path, root) in (shown.get(r["id"]) or "")
+        if not fresh and os.path.exists(path):
+            os.remove(path)
+    return shown
 
 
 def write_status(root, rows, shown):
@@ -459,7 +571,7 @@ def watch(root, chosen, opts, everything):
         sys.stdout.flush()
         if changed is not None:
             say(f"[check] {os.path.relpath(changed, root)} changed: checking again")
-        rows = check_once(root, chosen, opts)
+        rows = check_once(root, chosen, opts, in_order=everything and not opts.all)
         report(rows, root, opts, everything)
         say()
         say(f"[check] watching steps/ for changes ({how}; Ctrl-C stops)")
@@ -473,7 +585,10 @@ def main(argv, root=ROOT):
     p.add_argument("--hint", action="store_true", help="print the hint for the next exercise")
     p.add_argument("--watch", action="store_true", help="check again whenever a step's file changes")
     p.add_argument("--poll", action="store_true", help="--watch by polling, without inotifywait")
-    p.add_argument("--timeout", type=float, default=60.0, help="seconds for one exercise's tests")
+    p.add_argument("--all", action="store_true",
+                   help="every exercise now (default: stop after the step of the next one)")
+    p.add_argument("--timeout", type=float, default=EXERCISE_TIMEOUT,
+                   help=f"seconds for one exercise's tests (default {EXERCISE_TIMEOUT:g})")
     p.add_argument("--jobs", type=int, default=None, help="build jobs (default: the build's own)")
     p.add_argument("--no-pictures", action="store_true", help="no pictures (faster)")
     opts = p.parse_args(argv)
@@ -498,7 +613,7 @@ def main(argv, root=ROOT):
     try:
         if opts.watch:
             watch(root, chosen, opts, everything)
-        rows = check_once(root, chosen, opts)
+        rows = check_once(root, chosen, opts, in_order=everything and not opts.all)
         return report(rows, root, opts, everything)
     except KeyboardInterrupt as stopped:
         say()

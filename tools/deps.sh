@@ -1,6 +1,7 @@
 #!/usr/bin/env bash
 # Installs the Debian packages a workbook command needs, when they are missing.
 # usage: tools/deps.sh GROUP...   (groups: build test report slides fuzz grade bench watch, or all)
+# As root, the group build also installs the compiler cache (ccache), which no command needs.
 # As root it runs apt-get; otherwise it prints what an administrator runs once (the packages
 # are the machine's, for every user) and exits 1. Its logs are private temporary files,
 # removed when it ends, whatever the outcome: several users may run it at once.
@@ -64,6 +65,14 @@ pkgs_for() {
   esac
 }
 
+# Installed with a group when this runs as root, never required: without them the commands
+# work as before (an ordinary user is not asked for them).
+optional_for() {
+  case "$1" in
+  build | all) echo ccache ;; # the compiler cache: the CMake files use it where it is installed
+  esac
+}
+
 slides_npm() { # npm ci --prefix slides, when the group slides is asked for and the lock is newer
   [[ " $* " == *" slides "* ]] || return 0
   local stamp=$root/slides/node_modules/.package-lock.json
@@ -84,6 +93,14 @@ for p in "${wanted[@]}"; do
   status=$(dpkg-query -W -f='${Status}' "$p" 2>/dev/null || true)
   [[ "$status" == "install ok installed" ]] || missing+=("$p")
 done
+if [[ $(id -u) -eq 0 ]]; then
+  for group in "$@"; do
+    for p in $(optional_for "$group"); do
+      status=$(dpkg-query -W -f='${Status}' "$p" 2>/dev/null || true)
+      [[ "$status" == "install ok installed" ]] || missing+=("$p")
+    done
+  done
+fi
 # de-duplicate while keeping order
 mapfile -t missing < <(printf '%s\n' "${missing[@]}" | awk 'NF && !seen[$0]++')
 if [[ ${#missing[@]} -eq 0 ]]; then

@@ -3,6 +3,8 @@
 #include <SDL2/SDL_keycode.h>
 #include <imgui.h>
 
+#include <CLI/CLI.hpp>
+
 #include "01_triangle/measure.hpp"
 #include "01_triangle/triangle_grid.hpp"
 #include "core/render.hpp"

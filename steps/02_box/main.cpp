@@ -3,6 +3,8 @@
 #include <SDL2/SDL_keycode.h>
 #include <imgui.h>
 
+#include <CLI/CLI.hpp>
+
 #include "02_box/box_scene.hpp"
 #include "02_box/measure.hpp"
 #include "core/render.hpp"

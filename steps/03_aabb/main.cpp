@@ -4,6 +4,8 @@
 #include <SDL2/SDL_keycode.h>
 #include <imgui.h>
 
+#include <CLI/CLI.hpp>
+
 #include "03_aabb/measure.hpp"
 #include "core/step.hpp"
 

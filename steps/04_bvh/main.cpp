@@ -4,6 +4,7 @@
 #include <SDL2/SDL_keycode.h>
 #include <imgui.h>
 
+#include <CLI/CLI.hpp>
 #include <algorithm>
 #include <functional>
 #include <memory>

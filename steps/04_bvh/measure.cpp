@@ -1,5 +1,6 @@
 #include "04_bvh/measure.hpp"
 
+#include <CLI/CLI.hpp>
 #include <iostream>
 #include <memory>
 

@@ -1,6 +1,7 @@
 // Step 05: efficiency. The optimization lab (--measure prints every trade-off as time
 // against error) and perceived performance in the window: previews while the camera
 // moves, line-by-line refinement within a frame budget when it stops, a photograph mode.
+#include <CLI/CLI.hpp>
 #include <memory>
 
 #include "05_efficiency/bvh_mesh.hpp"

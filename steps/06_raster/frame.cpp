@@ -1,5 +1,6 @@
 #include "06_raster/frame.hpp"
 
+#include <CLI/CLI.hpp>
 #include <cmath>
 #include <iostream>
 

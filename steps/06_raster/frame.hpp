@@ -3,7 +3,6 @@
 // shaded), and the frame's figures for the report.
 #pragma once
 
-#include <CLI/CLI.hpp>
 #include <memory>
 #include <optional>
 #include <string>
@@ -11,6 +10,7 @@
 #include "06_raster/culling.hpp"
 #include "06_raster/pipeline.hpp"
 #include "06_raster/texture.hpp"
+#include "core/app.hpp"
 #include "core/report.hpp"
 
 namespace boxes {

@@ -1,5 +1,6 @@
 // Step 06: the same scene and camera drawn by rasterization, in software on the CPU, and
 // compared with the ray tracer pixel for pixel. SDL2 only shows the image.
+#include <CLI/CLI.hpp>
 #include <memory>
 #include <optional>
 

@@ -66,6 +66,35 @@ class Classify(unittest.TestCase):
         self.assertEqual(check.hint_for({"id": "1.4", "case": shown}, ({}, mistakes)),
                          ("check u + v", True))
 
+    def test_the_case_whose_mistake_fails_like_this_one_is_shown(self):
+        # A strict comparison fails the worked examples and the touching boxes; the worked
+        # examples are the catalogued case of another mistake (one axis only), which fails
+        # them alone: the touching boxes' case names this mistake.
+        cases = check.parse_cases(xml(case("worked examples", 1, FAILED_CHECK),
+                                      case("touching boxes", 1, FAILED_CHECK), case("other")))
+        check_ = "!hit.has_value()"
+        info = "ray O (0, 0, -1) D (0.9, 0.9, 1)"
+        fails = lambda *names: {k: 1 for n in names for k in (f"{n} | {check_}", f"{n} | {check_} | {info}")}
+        mistakes = {"worked examples": {"exercise": "1.4", "hint": "all axes",
+                                        "fails": fails("worked examples")},
+                    "touching boxes": {"exercise": "1.4", "hint": "compare with <=",
+                                       "fails": fails("worked examples", "touching boxes")}}
+        status, shown = check.classify("1.4", cases, mistakes)
+        self.assertEqual(shown["name"], "touching boxes")
+        self.assertEqual(check.hint_for({"id": "1.4", "status": status, "case": shown}, ({}, mistakes)),
+                         ("compare with <=", True))
+        # The worked examples alone failing: that mistake's own case and hint.
+        alone = check.parse_cases(xml(case("worked examples", 1, FAILED_CHECK), case("touching boxes")))
+        self.assertEqual(check.classify("1.4", alone, mistakes)[1]["name"], "worked examples")
+
+    def test_a_not_started_exercise_gets_its_exercise_hint(self):
+        cases = check.parse_cases(xml(case("touching boxes", 1, stub_exception("1.4"))))
+        mistakes = {"touching boxes": {"exercise": "1.4", "hint": "compare with <="}}
+        status, shown = check.classify("1.4", cases, mistakes)
+        self.assertEqual(status, "not started")
+        self.assertEqual(check.hint_for({"id": "1.4", "status": status, "case": shown},
+                                        ({"1.4": "generic"}, mistakes)), ("generic", False))
+
     def test_no_cases_is_no_tests(self):
         self.assertEqual(check.classify("1.4", [])[0], "no tests")
 
@@ -152,10 +181,39 @@ class Limits(unittest.TestCase):
         self.assertEqual(rows["1.1"]["detail"], '1 s in test case "its case"')
         self.assertEqual(rows["1.2"]["status"], "passed")
 
+    def test_in_order_the_steps_after_the_next_exercise_are_neither_built_nor_run(self):
+        chosen = [e for e in exercises(ROOT) if e.id in ("1.1", "1.2", "2.1")]
+        opts = mock.Mock(timeout=60.0, jobs=None)
+        with tempfile.TemporaryDirectory() as tmp:
+            self.tree(tmp, "exit 7")
+            with mock.patch.object(check, "configure", return_value=None), \
+                 mock.patch.object(check, "build_step", return_value=None) as built:
+                rows = {r["id"]: r for r in check.check_once(tmp, chosen, opts, in_order=True)}
+        self.assertEqual(rows["1.2"]["status"], "passed")  # the rest of the next one's step
+        self.assertEqual(rows["2.1"]["status"], "not checked")
+        self.assertEqual([c.args[1] for c in built.call_args_list], [1])
+
     def test_an_odd_exit_code_is_a_crash(self):
         rows = self.run_check("exit 7")
         self.assertEqual(rows["1.1"]["status"], "crashed")
         self.assertTrue(rows["1.1"]["detail"].startswith("exit code 7"), rows["1.1"]["detail"])
+
+
+class NoStalePicture(unittest.TestCase):
+    def test_a_timed_out_exercise_renders_nothing_and_its_old_picture_goes(self):
+        row = {"id": "1.4", "status": "timed out", "step": 1}
+        with tempfile.TemporaryDirectory() as tmp:
+            old = os.path.join(tmp, check.OUT, "1.4.png")
+            os.makedirs(os.path.dirname(old))
+            with open(old, "wb") as f:
+                f.write(b"an older run's picture")
+            with mock.patch.object(check, "build_targets") as built, \
+                 mock.patch.object(pictures, "render") as rendered:
+                shown = check.make_pictures(tmp, [row], row, mock.Mock(jobs=None))
+            built.assert_not_called()
+            rendered.assert_not_called()
+            self.assertEqual(shown["1.4"], "none: its tests did not finish, so its picture is not rendered")
+            self.assertFalse(os.path.exists(old))
 
 
 class Hints(unittest.TestCase):

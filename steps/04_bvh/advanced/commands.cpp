@@ -1,5 +1,6 @@
 #include "04_bvh/advanced/commands.hpp"
 
+#include <CLI/CLI.hpp>
 #include <cstdio>
 #include <ctime>
 #include <iostream>

@@ -4,12 +4,12 @@
 // `rays` writes ray sets.
 #pragma once
 
-#include <CLI/CLI.hpp>
 #include <cstdint>
 #include <optional>
 #include <string>
 
 #include "04_bvh/bvh.hpp"
+#include "core/app.hpp"
 
 namespace boxes {
 

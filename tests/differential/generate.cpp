@@ -22,6 +22,9 @@
 #include "differential/step01.hpp"
 #include "differential/step02.hpp"
 #include "differential/step03.hpp"
+#include "differential/step04.hpp"
+#include "differential/step05.hpp"
+#include "differential/step06.hpp"
 
 using namespace boxes::differential;
 
@@ -49,6 +52,18 @@ std::vector<DataSet> dataSets() {
     {
         constexpr int kStep = 3;
         BOXES_DIFFERENTIAL_STEP03(BOXES_ENTRY)
+    }
+    {
+        constexpr int kStep = 4;
+        BOXES_DIFFERENTIAL_STEP04(BOXES_ENTRY)
+    }
+    {
+        constexpr int kStep = 5;
+        BOXES_DIFFERENTIAL_STEP05(BOXES_ENTRY)
+    }
+    {
+        constexpr int kStep = 6;
+        BOXES_DIFFERENTIAL_STEP06(BOXES_ENTRY)
     }
 #undef BOXES_ENTRY
     return all;

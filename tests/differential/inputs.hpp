@@ -54,6 +54,11 @@ struct AxisMap {
         for (int k = 0; k < 3; ++k) out[axis[k]] = v[k] == 0.0 ? v[k] : sign[k] * v[k];
         return out;
     }
+    Vec3d invert(const Vec3d& v) const {
+        Vec3d out(0.0);
+        for (int k = 0; k < 3; ++k) out[k] = v[axis[k]] == 0.0 ? v[axis[k]] : sign[k] * v[axis[k]];
+        return out;
+    }
 };
 
 // ---- Rays and triangles -------------------------------------------------------------------

@@ -12,12 +12,15 @@ the starter kit leaves them out (kit.py), and this command runs in the reference
 
 usage: ./workbook mutants [N.M | NN | N.M-name ...] [--list] [--check]
        ./workbook mutants --safeguards [NAME ...] [--list] [--check]
+       ./workbook mutants --generate [N.M | NN ...] [--list] [--summary]
   (none: every mutant; N.M: an exercise's; NN: a step's; N.M-name: one mutant, in the
   order given)
   --list   the catalogue
   --check  only check the catalogue: every patch applies, names its case, has a hint
   --safeguards  the hard cases' safeguards removed instead (tests/safeguards,
            tools/grading/safeguards.py): exactly the named hard cases must fail
+  --generate  the mechanical mutants of each solution body instead, and the mutation
+           score per exercise (tools/grading/mutant_generator.py)
 
 Each mutant is applied to a private copy of the tree (build/mutants/tree, kept between
 runs so that its build is incremental), the exercise's test program alone is built, the
@@ -317,6 +320,9 @@ def main(argv):
     if "--safeguards" in argv:
         from . import safeguards
         return safeguards.main(argv)
+    if "--generate" in argv:
+        from . import mutant_generator
+        return mutant_generator.main(argv)
     args = [a for a in argv if not a.startswith("-")]
     flags = [a for a in argv if a.startswith("-")]
     for f in flags:

@@ -13,7 +13,8 @@ thing in one line of the body (between BEGIN SOLUTION and END SOLUTION):
   logical      && and ||, a ! dropped, a unary minus dropped
   constant     an integer n as n + 1 and n - 1, a floating-point constant as 0 and twice itself
   min/max      min and max swapped (std::, glm::), floor and ceil
-  statement    a statement dropped (an `if (...) return ...;` guard with it)
+  statement    a statement dropped (an `if (...) return ...;` guard with it; not a body's
+               last return, which would fall off the function's end)
   precision    double as float (the routine's own precision lost)
 
 A survivor is killed by a new test case or argued equivalent (it computes what the
@@ -31,7 +32,9 @@ How: all the mutants of an exercise are compiled at once into a private copy of 
 (mutants.py's, build/mutants/tree), each as one case of a switch over copies of the
 solution body that reads the mutant's number from BOXES_MUTANT at run time (mutant
 schemata: one build per exercise, not one per mutant); the exercise's doctest suite is run
-once per mutant (tools/check.py's runner). A copy that does not compile is dropped by the
+once per mutant (tools/check.py's runner). The private tree is built with the standard
+library's bounds checks (-D_GLIBCXX_ASSERTIONS): a loop one past an array's end crashes
+there, as CI's sanitizer run would report it. A copy that does not compile is dropped by the
 compiler's line numbers and the rest built again. The file is restored afterwards.
 """
 import hashlib
@@ -191,6 +194,8 @@ def statement_drops(lines, codes):
             continue
         if text.count("(") != text.count(")") or text.count("{") != text.count("}"):
             continue
+        if text.startswith("return "):
+            continue  # a body without its last return falls off its end: undefined, not a mistake
         prev = codes[i - 1].strip() if i > 0 else ""
         if re.match(r"(if|for|while)\b", prev) and prev.endswith(")") and prev.count("(") == prev.count(")"):
             drops.append((i - 1, i, "`" + prev + " " + text + "` dropped"))
@@ -285,7 +290,7 @@ def schema(text, ex, mutants):
 
 
 def error_lines(output, rel):
-    """The lines of `rel` that the compiler's errors name."""
+    """The lines of `rel` that the compiler's errors name (a set; empty: none)."""
     found = set()
     name = re.escape(rel)
     for m in re.finditer(r"^(?:.*/)?" + name + r":(\d+):(?:\d+:)? (?:fatal )?error:", output, re.M):
@@ -298,6 +303,26 @@ def error_lines(output, rel):
 
 def nice(cmd):
     return ["nice", "-n", "10"] + cmd if os.path.exists("/usr/bin/nice") else cmd
+
+
+# The mutants' build checks the standard library's bounds (std::array, std::vector): a loop
+# one past its end is then a crash the tests see, as the sanitizer run of CI sees it, instead
+# of a write past the array that a release build may survive.
+CHECKED = "-D_GLIBCXX_ASSERTIONS"
+
+
+def checked_build(tree, log):
+    """Adds CHECKED to the private tree's flags (once; it rebuilds the tree)."""
+    cache = os.path.join(build_dir(tree), "CMakeCache.txt")
+    try:
+        with open(cache, encoding="utf-8") as f:
+            if re.search(r"^CMAKE_CXX_FLAGS:STRING=.*" + re.escape(CHECKED), f.read(), re.M):
+                return True
+    except OSError:
+        return False
+    r = subprocess.run(["cmake", f"-DCMAKE_CXX_FLAGS={CHECKED}", build_dir(tree)],
+                       stdout=log, stderr=subprocess.STDOUT)
+    return r.returncode == 0
 
 
 def build(tree, step, log):
@@ -373,8 +398,12 @@ def run_exercise(tree, ex, mutants, timeout, log, say):
                 if ok:
                     break
                 bad = set()
-                for line in error_lines(output, rel):
+                lines = error_lines(output, rel)
+                for line in lines:
                     bad |= {n for n, (a, b) in ranges.items() if a <= line <= b}
+                if len(bad) > max(3, len(chunk) // 2):
+                    # Errors that cascade past one copy (a brace lost): drop the first one only.
+                    bad = {n for n, (a, b) in ranges.items() if a <= min(lines) <= b}
                 if not bad:
                     raise RuntimeError(f"{ex.id}: the schema does not compile outside the mutants' "
                                        f"copies (see {log.name})")
@@ -504,7 +533,7 @@ def main(argv):
         print(text, file=sys.stderr, flush=True)
 
     with open(log_path, "w", encoding="utf-8") as log:
-        if not configure(tree, log):
+        if not configure(tree, log) or not checked_build(tree, log):
             print(f"mutants --generate: configuring the private tree failed (see {log_path})", file=sys.stderr)
             return 1
         for e in chosen:

@@ -3,6 +3,7 @@
 // starter kit it would write the stubs' answers, so the command refuses to run there.
 //
 //   differential_data --write DIR [--seed S] [NAME ...]   DIR/NAME.txt (the shipped sets: seed 1)
+//   differential_data --check DIR                         the shipped sets are this tree's answers
 //   differential_data --hidden DIR --seed S               DIR/stepNN_differential_hidden.cpp
 //   differential_data --show NAME [--seed S]              each input, its family and answer
 //   differential_data --list                              the data sets
@@ -15,6 +16,7 @@
 #include <cstring>
 #include <fstream>
 #include <iostream>
+#include <iterator>
 #include <map>
 #include <string>
 #include <vector>
@@ -116,7 +118,8 @@ int main(int argc, char** argv) {
     bool seedGiven = false;
     std::vector<std::string> names;
     for (size_t i = 0; i < args.size(); ++i) {
-        if ((args[i] == "--write" || args[i] == "--hidden") && i + 1 < args.size()) {
+        if ((args[i] == "--write" || args[i] == "--hidden" || args[i] == "--check") &&
+            i + 1 < args.size()) {
             mode = args[i];
             dir = args[++i];
         } else if (args[i] == "--seed" && i + 1 < args.size()) {
@@ -162,6 +165,29 @@ int main(int argc, char** argv) {
             return 2;
         }
         return 0;
+    }
+    if (mode == "--check") {
+        // The tree's reference reproduces every shipped data set, byte for byte: the answers
+        // a starter kit's tests compare with are this tree's.
+        int stale = 0;
+        for (const auto& s : sets) {
+            std::ifstream in(dir + "/" + s.name + ".txt", std::ios::binary);
+            std::string shipped((std::istreambuf_iterator<char>(in)),
+                                std::istreambuf_iterator<char>());
+            std::string made = s.generate(1);
+            if (shipped == made) continue;
+            ++stale;
+            size_t at = 0, line = 1;
+            while (at < shipped.size() && at < made.size() && shipped[at] == made[at])
+                line += shipped[at++] == '\n';
+            std::cerr << "differential_data: " << dir << "/" << s.name
+                      << ".txt differs from the reference's answers"
+                      << (shipped.empty() ? " (missing)" : " from line " + std::to_string(line))
+                      << " (./workbook differential --write)\n";
+        }
+        std::cout << sets.size() - size_t(stale) << " of " << sets.size()
+                  << " data sets are the reference's answers\n";
+        return stale ? 1 : 0;
     }
     if (mode == "--hidden") {
         if (!seedGiven || seed == 1) {

@@ -32,9 +32,9 @@ How: all the mutants of an exercise are compiled at once into a private copy of 
 (mutants.py's, build/mutants/tree), each as one case of a switch over copies of the
 solution body that reads the mutant's number from BOXES_MUTANT at run time (mutant
 schemata: one build per exercise, not one per mutant); the exercise's doctest suite is run
-once per mutant (tools/check.py's runner). The private tree is built with the standard
-library's bounds checks (-D_GLIBCXX_ASSERTIONS): a loop one past an array's end crashes
-there, as CI's sanitizer run would report it. A copy that does not compile is dropped by the
+once per mutant (tools/check.py's runner). The private tree is built with bounds checks
+(the standard library's and GLM's asserts): a loop one past an array's end crashes there,
+as CI's sanitizer run would report it. A copy that does not compile is dropped by the
 compiler's line numbers and the rest built again. The file is restored afterwards.
 """
 import hashlib
@@ -305,22 +305,25 @@ def nice(cmd):
     return ["nice", "-n", "10"] + cmd if os.path.exists("/usr/bin/nice") else cmd
 
 
-# The mutants' build checks the standard library's bounds (std::array, std::vector): a loop
-# one past its end is then a crash the tests see, as the sanitizer run of CI sees it, instead
-# of a write past the array that a release build may survive.
-CHECKED = "-D_GLIBCXX_ASSERTIONS"
+# The mutants' build checks bounds: the standard library's (std::array, std::vector) and
+# GLM's (its asserts, which the release flags' NDEBUG turns off: glm::vec3's operator[]
+# then reads x for index 3). A loop one past its end is a crash the tests see, as CI's
+# sanitizer run sees it, instead of a read the release build may survive. -O2: the same
+# arithmetic as -O3 (no fast math, no contraction) at less compile time.
+CHECKED = {"CMAKE_CXX_FLAGS": "-D_GLIBCXX_ASSERTIONS", "CMAKE_CXX_FLAGS_RELEASE": "-O2"}
 
 
 def checked_build(tree, log):
-    """Adds CHECKED to the private tree's flags (once; it rebuilds the tree)."""
+    """Sets CHECKED in the private tree's cache (once; it rebuilds the tree)."""
     cache = os.path.join(build_dir(tree), "CMakeCache.txt")
     try:
         with open(cache, encoding="utf-8") as f:
-            if re.search(r"^CMAKE_CXX_FLAGS:STRING=.*" + re.escape(CHECKED), f.read(), re.M):
-                return True
+            text = f.read()
     except OSError:
         return False
-    r = subprocess.run(["cmake", f"-DCMAKE_CXX_FLAGS={CHECKED}", build_dir(tree)],
+    if all(re.search(rf"^{k}:STRING={re.escape(v)}$", text, re.M) for k, v in CHECKED.items()):
+        return True
+    r = subprocess.run(["cmake"] + [f"-D{k}={v}" for k, v in CHECKED.items()] + [build_dir(tree)],
                        stdout=log, stderr=subprocess.STDOUT)
     return r.returncode == 0
 

@@ -345,11 +345,12 @@ using MollerTrumboreFloat = RayTriangleSpec<float, 4>;
 using MollerTrumboreDouble = RayTriangleSpec<double, 4>;
 using WatertightFloat = RayTriangleSpec<float, 5>;
 using WatertightDouble = RayTriangleSpec<double, 5>;
-#define BOXES_DIFFERENTIAL_STEP01(X)                                             \
-    X(TrianglePlaneFloat)                                                        \
-    X(TrianglePlaneDouble)                                                       \
-    X(RayPlaneDistanceFloat) X(RayPlaneDistanceDouble) X(InsideEdgePlanesFloat)  \
-        X(InsideEdgePlanesDouble) X(MollerTrumboreFloat) X(MollerTrumboreDouble) \
-            X(WatertightFloat) X(WatertightDouble) X(InterpolateNormalSpec)
+#define BOXES_DIFFERENTIAL_STEP01(X)                                                          \
+    X(TrianglePlaneFloat)                                                                     \
+    X(TrianglePlaneDouble)                                                                    \
+    X(RayPlaneDistanceFloat)                                                                  \
+    X(RayPlaneDistanceDouble) X(InsideEdgePlanesFloat) X(InsideEdgePlanesDouble)              \
+        X(MollerTrumboreFloat) X(MollerTrumboreDouble) X(WatertightFloat) X(WatertightDouble) \
+            X(InterpolateNormalSpec)
 
 }  // namespace boxes::differential

@@ -320,11 +320,12 @@ using SlabsFloat = SlabIntervalSpec<float, false>;
 using SlabsDouble = SlabIntervalSpec<double, false>;
 using SlabsConservativeFloat = SlabIntervalSpec<float, true>;
 using SlabsConservativeDouble = SlabIntervalSpec<double, true>;
-#define BOXES_DIFFERENTIAL_STEP03(X)                                                         \
-    X(SphereBoundsFloat)                                                                     \
-    X(SphereBoundsDouble)                                                                    \
-    X(TriangleBoundsFloat) X(TriangleBoundsDouble) X(MeshBoundsSpec) X(UnionBoundsFloat)     \
-        X(UnionBoundsDouble) X(OverlapsFloat) X(OverlapsDouble) X(SlabsFloat) X(SlabsDouble) \
-            X(SlabsConservativeFloat) X(SlabsConservativeDouble)
+#define BOXES_DIFFERENTIAL_STEP03(X)                                                              \
+    X(SphereBoundsFloat)                                                                          \
+    X(SphereBoundsDouble)                                                                         \
+    X(TriangleBoundsFloat)                                                                        \
+    X(TriangleBoundsDouble) X(MeshBoundsSpec) X(UnionBoundsFloat) X(UnionBoundsDouble)            \
+        X(OverlapsFloat) X(OverlapsDouble) X(SlabsFloat) X(SlabsDouble) X(SlabsConservativeFloat) \
+            X(SlabsConservativeDouble)
 
 }  // namespace boxes::differential

@@ -47,8 +47,9 @@ import time
 from dataclasses import dataclass, field
 
 from . import ROOT
+from .. import build as cmake
 from .exercises import case_results, exercises
-from .mutants import build_dir, configure, private_tree
+from .mutants import build_dir, private_tree
 
 EQUIVALENT = "tests/mutants/equivalent.json"
 RESULTS = os.path.join("build", "mutants", "generated.json")
@@ -301,10 +302,6 @@ def error_lines(output, rel):
 # ---- Running --------------------------------------------------------------------------------------
 
 
-def nice(cmd):
-    return ["nice", "-n", "10"] + cmd if os.path.exists("/usr/bin/nice") else cmd
-
-
 # The mutants' build checks bounds: the standard library's (std::array, std::vector) and
 # GLM's (its asserts, which the release flags' NDEBUG turns off: glm::vec3's operator[]
 # then reads x for index 3). A loop one past its end is a crash the tests see, as CI's
@@ -312,29 +309,18 @@ def nice(cmd):
 # arithmetic as -O3 (no fast math, no contraction) at less compile time.
 CHECKED = {"CMAKE_CXX_FLAGS": "-D_GLIBCXX_ASSERTIONS", "CMAKE_CXX_FLAGS_RELEASE": "-O2"}
 
-
-def checked_build(tree, log):
-    """Sets CHECKED in the private tree's cache (once; it rebuilds the tree)."""
-    cache = os.path.join(build_dir(tree), "CMakeCache.txt")
-    try:
-        with open(cache, encoding="utf-8") as f:
-            text = f.read()
-    except OSError:
-        return False
-    if all(re.search(rf"^{k}:STRING={re.escape(v)}$", text, re.M) for k, v in CHECKED.items()):
-        return True
-    r = subprocess.run(["cmake"] + [f"-D{k}={v}" for k, v in CHECKED.items()] + [build_dir(tree)],
-                       stdout=log, stderr=subprocess.STDOUT)
-    return r.returncode == 0
+def build_tree(tree):
+    """The private tree's build as tools/build.py configures it: mutants.py's settings (no
+    step programs, no link-time optimisation) and CHECKED."""
+    return cmake.Tree(tree, build_dir(tree), "release",
+                      {"BOXES_TESTS_BUILD_PROGRAMS": "OFF", "BOXES_LTO": "OFF", **CHECKED})
 
 
-def build(tree, step, log):
-    target = f"test_step{step:02d}"
-    r = subprocess.run(nice(["cmake", "--build", build_dir(tree), "--target", target, "-j2"]),
-                       capture_output=True, text=True)
-    log.write(r.stdout + r.stderr)
+def build(btree, step, log):
+    """Builds the step's test program: (ok, the compiler's output)."""
+    r = cmake.build(btree, [f"test_step{step:02d}"], jobs=2, log=log)
     log.flush()
-    return r.returncode == 0, r.stdout + r.stderr
+    return r.ok, r.output
 
 
 def run_tests(tree, step, exercise, number, timeout):
@@ -381,7 +367,7 @@ def save_results(results, root=ROOT):
     os.replace(path + ".new", path)
 
 
-def run_exercise(tree, ex, mutants, timeout, log, say):
+def run_exercise(tree, btree, ex, mutants, timeout, log, say):
     """Every mutant of one exercise: {key: (status, how)}, status killed, survived,
     stillborn (does not compile) or reference (the reference itself fails)."""
     rel = ex.path
@@ -397,7 +383,7 @@ def run_exercise(tree, ex, mutants, timeout, log, say):
                 with open(path, "w", encoding="utf-8") as f:
                     f.write(text)
                 say(f"[generated] {ex.id}: building {len(chunk)} mutants (one switch)")
-                ok, output = build(tree, ex.step, log)
+                ok, output = build(btree, ex.step, log)
                 if ok:
                     break
                 bad = set()
@@ -524,10 +510,15 @@ def main(argv):
         print("mutants --generate: runs in the reference tree (with the solutions), not in a starter kit",
               file=sys.stderr)
         return 2
-    # The private tree's build through the compiler cache where there is one.
-    if not os.environ.get("CMAKE_CXX_COMPILER_LAUNCHER") and os.path.exists("/usr/bin/ccache"):
+    # The private tree's build through the compiler cache where there is one (until the CMake
+    # files use it themselves), at low priority: it is long, and the machine is shared.
+    with open(os.path.join(ROOT, "CMakeLists.txt"), encoding="utf-8") as f:
+        cache_in_cmake = "BOXES_CCACHE" in f.read()
+    if not cache_in_cmake and not os.environ.get("CMAKE_CXX_COMPILER_LAUNCHER") and os.path.exists("/usr/bin/ccache"):
         os.environ["CMAKE_CXX_COMPILER_LAUNCHER"] = "ccache"
+    os.nice(10)
     tree = private_tree()
+    btree = build_tree(tree)
     log_path = os.path.join(ROOT, "build", "mutants", "generated-log.txt")
     results = load_results()
     started = time.monotonic()
@@ -536,13 +527,13 @@ def main(argv):
         print(text, file=sys.stderr, flush=True)
 
     with open(log_path, "w", encoding="utf-8") as log:
-        if not configure(tree, log) or not checked_build(tree, log):
+        if not cmake.configure(btree, log=log).ok:
             print(f"mutants --generate: configuring the private tree failed (see {log_path})", file=sys.stderr)
             return 1
         for e in chosen:
             t0 = time.monotonic()
             mutants = generated[e.id]
-            outcome = run_exercise(tree, e, mutants, timeout, log, say)
+            outcome = run_exercise(tree, btree, e, mutants, timeout, log, say)
             results[e.id] = {
                 "outcome": outcome,
                 "descriptions": {m.key: m.description for m in mutants},

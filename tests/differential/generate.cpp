@@ -14,6 +14,7 @@
 #include <charconv>
 #include <cstdio>
 #include <cstring>
+#include <filesystem>
 #include <fstream>
 #include <iostream>
 #include <iterator>
@@ -195,6 +196,8 @@ int main(int argc, char** argv) {
                 << "differential_data: --hidden needs --seed S other than the shipped sets' 1\n";
             return 2;
         }
+        std::error_code ec;
+        std::filesystem::create_directories(dir, ec);
         std::map<int, std::vector<DataSet>> bySteps;
         for (const auto& s : sets) bySteps[s.step].push_back(s);
         for (const auto& [step, list] : bySteps) {

@@ -508,7 +508,8 @@ void check(std::string_view data) {
     INFO("exercise " << std::string(Spec::exercise) << " (" << std::string(Spec::name)
                      << ") against the reference's answers on " << cases.size()
                      << " generated inputs: " << differing << " differ; the first"
-                     << (firstExact ? " built for exact arithmetic" : "") << ": " << first);
+                     << std::string(firstExact ? " built for exact arithmetic" : "") << ": "
+                     << first);
     CHECK(differing == 0);
     (void)ambiguousAccepted;
 }

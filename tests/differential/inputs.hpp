@@ -182,9 +182,11 @@ Case<RayTriangle<T>> exactRayTriangle(Rng& rng) {
 // At random: a triangle at a scale, a ray aimed at barycentrics in [-0.2, 1.2]^2 from a
 // random direction; grazing rays nearly in the plane; huge and tiny scenes.
 template <typename T>
-Case<RayTriangle<T>> randomRayTriangle(Rng& rng, int hugeExponent, int tinyExponent) {
+Case<RayTriangle<T>> randomRayTriangle(Rng& rng, int hugeExponent, int tinyExponent,
+                                       int forcedKind = -1) {
     const char* family = "a random ray and triangle";
     int kind = rng.below(10);
+    if (forcedKind >= 0) kind = forcedKind;
     double scale = rng.logUniform(-3, 3);
     if (kind == 8) {
         scale = std::ldexp(1.0, rng.range(hugeExponent - 8, hugeExponent));

@@ -303,11 +303,11 @@ using AxisPlaneDistanceFloat = AxisPlaneDistanceSpec<float>;
 using AxisPlaneDistanceDouble = AxisPlaneDistanceSpec<double>;
 using BoxSlabsFloat = BoxIntersectionSpec<float, 4>;
 using BoxSlabsDouble = BoxIntersectionSpec<double, 4>;
-#define BOXES_DIFFERENTIAL_STEP02(X)                                                         \
-    X(BoxFacePlanesFloat)                                                                    \
-    X(BoxFacePlanesDouble)                                                                   \
-    X(SixPlanesFloat)                                                                        \
-    X(SixPlanesDouble) X(AxisPlaneDistanceFloat) X(AxisPlaneDistanceDouble) X(BoxSlabsFloat) \
-        X(BoxSlabsDouble)
+#define BOXES_DIFFERENTIAL_STEP02(X) \
+    X(BoxFacePlanesFloat)            \
+    X(BoxFacePlanesDouble)           \
+    X(SixPlanesFloat)                \
+    X(SixPlanesDouble)               \
+    X(AxisPlaneDistanceFloat) X(AxisPlaneDistanceDouble) X(BoxSlabsFloat) X(BoxSlabsDouble)
 
 }  // namespace boxes::differential

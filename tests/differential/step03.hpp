@@ -324,8 +324,8 @@ using SlabsConservativeDouble = SlabIntervalSpec<double, true>;
     X(SphereBoundsFloat)                                                                          \
     X(SphereBoundsDouble)                                                                         \
     X(TriangleBoundsFloat)                                                                        \
-    X(TriangleBoundsDouble) X(MeshBoundsSpec) X(UnionBoundsFloat) X(UnionBoundsDouble)            \
-        X(OverlapsFloat) X(OverlapsDouble) X(SlabsFloat) X(SlabsDouble) X(SlabsConservativeFloat) \
-            X(SlabsConservativeDouble)
+    X(TriangleBoundsDouble)                                                                       \
+    X(MeshBoundsSpec) X(UnionBoundsFloat) X(UnionBoundsDouble) X(OverlapsFloat) X(OverlapsDouble) \
+        X(SlabsFloat) X(SlabsDouble) X(SlabsConservativeFloat) X(SlabsConservativeDouble)
 
 }  // namespace boxes::differential

@@ -746,10 +746,10 @@ struct CullSpec {
 
 using CullByPlanesSpec = CullSpec<7>;
 using CullByBoxPlanesSpec = CullSpec<8>;
-#define BOXES_DIFFERENTIAL_STEP04(X)                                                        \
-    X(MidpointSpec)                                                                         \
-    X(MedianSpec)                                                                           \
-    X(BinnedSahSpec) X(NearestHitSpec) X(AnyHitSpec) X(MakeFrustumSpec) X(CullByPlanesSpec) \
-        X(CullByBoxPlanesSpec)
+#define BOXES_DIFFERENTIAL_STEP04(X) \
+    X(MidpointSpec)                  \
+    X(MedianSpec)                    \
+    X(BinnedSahSpec)                 \
+    X(NearestHitSpec) X(AnyHitSpec) X(MakeFrustumSpec) X(CullByPlanesSpec) X(CullByBoxPlanesSpec)
 
 }  // namespace boxes::differential

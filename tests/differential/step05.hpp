@@ -423,10 +423,11 @@ struct AdaptiveSpec {
 
 using SinNearestSpec = SinTableSpec<false>;
 using SinInterpolatedSpec = SinTableSpec<true>;
-#define BOXES_DIFFERENTIAL_STEP05(X)                                                \
-    X(FillSinTableSpec)                                                             \
-    X(SinNearestSpec)                                                               \
-    X(SinInterpolatedSpec) X(EarlyOutSpec) X(LightRadiusSpec) X(ReciprocalSlabSpec) \
-        X(PrecomputedTriangleSpec) X(InverseSqrtSpec) X(RefineSpec) X(AdaptiveSpec)
+#define BOXES_DIFFERENTIAL_STEP05(X)                                                    \
+    X(FillSinTableSpec)                                                                 \
+    X(SinNearestSpec)                                                                   \
+    X(SinInterpolatedSpec)                                                              \
+    X(EarlyOutSpec) X(LightRadiusSpec) X(ReciprocalSlabSpec) X(PrecomputedTriangleSpec) \
+        X(InverseSqrtSpec) X(RefineSpec) X(AdaptiveSpec)
 
 }  // namespace boxes::differential

@@ -570,10 +570,11 @@ struct ShadowRaySpec {
     }
 };
 
-#define BOXES_DIFFERENTIAL_STEP06(X)                                       \
-    X(SpaceMatricesSpec)                                                   \
-    X(ClipToScreenSpec)                                                    \
-    X(ClipPolygonSpec) X(EdgeFunctionSpec) X(TopLeftSpec) X(DepthTestSpec) \
-        X(PerspectiveWeightsSpec) X(ShadowMapSpec) X(ShadowRaySpec)
+#define BOXES_DIFFERENTIAL_STEP06(X)                                                               \
+    X(SpaceMatricesSpec)                                                                           \
+    X(ClipToScreenSpec)                                                                            \
+    X(ClipPolygonSpec)                                                                             \
+    X(EdgeFunctionSpec) X(TopLeftSpec) X(DepthTestSpec) X(PerspectiveWeightsSpec) X(ShadowMapSpec) \
+        X(ShadowRaySpec)
 
 }  // namespace boxes::differential

@@ -49,6 +49,11 @@ struct ImageDifference {
 // Throws std::invalid_argument when the sizes differ.
 ImageDifference compareImages(const Image& a, const Image& b, float threshold = 0.0f);
 
+// A PNG's companions: pngStem("a.png") is "a", pngWithSuffix("a.png", "-cull") is
+// "a-cull.png".
+std::string pngStem(const std::string& png);
+std::string pngWithSuffix(const std::string& png, const std::string& suffix);
+
 // Writes a file through a temporary name and a rename (no partial files).
 void writeFileAtomically(const std::string& path, const void* data, size_t size);
 

@@ -218,13 +218,15 @@ void addMeasurements(Report& report, const NamedMesh& mesh, const Bvh& bvh,
 }
 
 void addTreeReport(Report& report, const Scene& scene, const MeshBvhGeometry& geometry,
-                   const std::string& png, const CommonOptions& options,
-                   const MeasureSettings& settings) {
+                   const std::string& png, const CommonOptions& options) {
     report.facts["build_ms"] = geometry.stats().buildMs;
     report.facts["nodes"] = geometry.stats().nodes;
     report.facts["sah_cost"] = geometry.stats().sahCost;
     addCullingMap(report, geometry.bvh(), png, options.width, options.height, scene.camera.up);
-    if (!settings.enabled) return;
+}
+
+void measureTree(Report& report, const Scene& scene, const MeshBvhGeometry& geometry,
+                 const CommonOptions& options, const MeasureSettings& settings) {
     MeasureSettings run = settings;
     run.seed = options.seed;
     run.dataDir = options.dataDir;
@@ -232,8 +234,6 @@ void addTreeReport(Report& report, const Scene& scene, const MeshBvhGeometry& ge
 }
 
 void addMeasureOptions(CLI::App& app, MeasureSettings& settings) {
-    app.add_flag("--measure", settings.enabled,
-                 "also measure builders, traversal, cracks and culling");
     app.add_option("--measure-rays", settings.traceRays, "rays per kind in the speed table")
         ->check(CLI::Range(size_t(100), size_t(10000000)));
     app.add_option("--crack-rays", settings.crackRays,

@@ -8,13 +8,13 @@ import glob
 import os
 import re
 import shutil
-import sys
 import tempfile
 import unittest
 
-ROOT = os.path.dirname(os.path.dirname(os.path.dirname(os.path.abspath(__file__))))
-sys.path.insert(0, ROOT)
-from tools.grading import kit  # noqa: E402
+from tests.tools import scratch  # noqa: F401  (tempfile's folders: one, removed at exit)
+
+from tools import ROOT
+from tools.grading import kit
 
 DATA = os.path.join(ROOT, "tests", "differential", "data")
 

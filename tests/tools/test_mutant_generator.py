@@ -6,14 +6,13 @@ the exercises is ./workbook mutants --generate itself."""
 import os
 import shutil
 import subprocess
-import sys
 import tempfile
 import unittest
 
-ROOT = os.path.dirname(os.path.dirname(os.path.dirname(os.path.abspath(__file__))))
-sys.path.insert(0, ROOT)
-from tools.grading import mutant_generator as gen  # noqa: E402
-from tools.grading.exercises import parse_file  # noqa: E402
+from tests.tools import scratch  # noqa: F401  (tempfile's folders: one, removed at exit)
+
+from tools.grading import mutant_generator as gen
+from tools.grading.exercises import parse_file
 
 SOURCE = """#include <algorithm>
 #include <array>

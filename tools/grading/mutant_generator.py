@@ -49,7 +49,7 @@ from dataclasses import dataclass, field
 from . import ROOT
 from .. import build as cmake
 from .exercises import case_results, exercises
-from .mutants import build_dir, private_tree
+from .mutants import build_dir, private_tree, release_tree
 
 EQUIVALENT = "tests/mutants/equivalent.json"
 RESULTS = os.path.join("build", "mutants", "generated.json")
@@ -310,10 +310,11 @@ def error_lines(output, rel):
 CHECKED = {"CMAKE_CXX_FLAGS": "-D_GLIBCXX_ASSERTIONS", "CMAKE_CXX_FLAGS_RELEASE": "-O2"}
 
 def build_tree(tree):
-    """The private tree's build as tools/build.py configures it: mutants.py's settings (no
-    step programs, no link-time optimisation) and CHECKED."""
-    return cmake.Tree(tree, build_dir(tree), "release",
-                      {"BOXES_TESTS_BUILD_PROGRAMS": "OFF", "BOXES_LTO": "OFF", **CHECKED})
+    """The private tree's build: mutants.py's (no step programs, no link-time optimisation)
+    with CHECKED."""
+    t = release_tree(tree)
+    t.cache.update(CHECKED)
+    return t
 
 
 def build(btree, step, log):

@@ -5,7 +5,7 @@
 #include <random>
 
 #include "01_triangle/triangle.hpp"
-#include "core/triangle_hit.hpp"
+#include "core/mesh.hpp"
 
 namespace boxes {
 

@@ -5,9 +5,10 @@
 #include <imgui.h>
 
 #include <algorithm>
+#include <functional>
 #include <memory>
+#include <optional>
 
-#include "04_bvh/advanced/commands.hpp"
 #include "04_bvh/culling_map.hpp"
 #include "04_bvh/measure.hpp"
 #include "04_bvh/trace.hpp"
@@ -18,10 +19,12 @@ using namespace boxes;
 int main(int argc, char** argv) {
     std::string builderName = "sah";
     MeasureSettings measure;
-    std::unique_ptr<EngineCommands> commands;  // trace and check, on the same command line
+    std::function<std::optional<int>()> engineCommand;  // trace, check, rays (measure.hpp)
     BvhBuildOptions build;
     std::shared_ptr<MeshBvhGeometry> geometry;  // the scene's mesh; none for a scene without one
 
+    // What the step is, for the shell (core/step.hpp): every main fills the same fields,
+    // then adds its own flags, tables and keys.
     StepProgram step;
     step.name = "04_bvh";
     step.description =
@@ -38,9 +41,9 @@ int main(int argc, char** argv) {
             ->check(CLI::Range(2, 256))
             ->capture_default_str();
         addMeasureOptions(app, measure);
-        commands = std::make_unique<EngineCommands>(app);
+        engineCommand = addEngineCommands(app);
     };
-    step.command = [&] { return commands->run(); };
+    step.command = [&] { return engineCommand(); };
     // The mesh through a hierarchy of the chapter's builders (trace.hpp).
     step.addGeometry = [&](StepRun& run) {
         build.builder = parseBvhBuilder(builderName);

@@ -18,8 +18,9 @@ namespace boxes {
 // excess over the full-sweep SAH tree. Table id "bvh_build".
 Table measureBuilds(const NamedMesh& mesh, int bins, int repeats);
 
-// Per builder and ray kind: Mrays/s on one thread (median of repeats) and the rays whose
-// nearest hit differs from brute force on a sample. Table id "bvh_trace".
+// Per builder and ray kind: Mrays/s on one thread (median of repeats), the tree's SAH cost
+// and the rays whose nearest hit differs from brute force on a sample (no build time: that
+// is bvh_build's). Table id "bvh_trace".
 Table measureTraceSpeed(const NamedMesh& mesh, size_t rays, size_t bruteForceRays, int repeats,
                         uint64_t seed, int bins);
 
@@ -30,10 +31,10 @@ Table measureThreads(const NamedMesh& mesh, size_t rays, int repeats, uint64_t s
 // enough that the frustum cuts it. Table id "bvh_culling".
 Table measureCulling(const NamedMesh& mesh, const Bvh& bvh, int cameras);
 
-// Build time and trace speed per builder (primary rays) beside the rays it loses against
-// brute force and its cracks, from measureTraceSpeed's and measureBvhCracks's tables.
-// Table id "bvh_tradeoff".
-Table measureTradeoff(const Table& traceSpeed, const Table& cracks);
+// Build time (bvh_build's median) and trace speed per builder (primary rays) beside the rays
+// it loses against brute force and its cracks, from measureBuilds's, measureTraceSpeed's and
+// measureBvhCracks's tables. Table id "bvh_tradeoff".
+Table measureTradeoff(const Table& builds, const Table& traceSpeed, const Table& cracks);
 
 // The whole `--measure` run on the scene's mesh and `bvh` (the program's tree), with the
 // crack count on the bunny and sh1 from dataDir, and the trade-off's plot.
@@ -46,9 +47,9 @@ struct MeasureSettings {
 };
 void addMeasurements(Report& report, const NamedMesh& mesh, const Bvh& bvh,
                      const MeasureSettings& settings);
-// The headless report's part of the tree: its figures (build_ms, nodes, sah_cost), the
-// culling map beside `png`, and with settings.enabled the tables (seed and data folder
-// from `options`).
+// The headless report's part of the tree: its figures (nodes, sah_cost; build_ms without
+// --measure, whose bvh_build table times every builder), the culling map beside `png`, and
+// with settings.enabled the tables (seed and data folder from `options`).
 void addTreeReport(Report& report, const Scene& scene, const MeshBvhGeometry& geometry,
                    const std::string& png, const CommonOptions& options,
                    const MeasureSettings& settings);

@@ -5,7 +5,7 @@ usage: fuzz/fuzz_results.py SECONDS [--artifacts DIR]   fuzz for SECONDS (fuzz/f
        fuzz/fuzz_results.py --replay PATH...             every corpus file once (ctest)
 
 The functions: tools/grading/exercises.py case_results (doctest's XML results, from a file as
-the grader and the tour's report read them, and from a string), and tools/grading/grade.py
+the grader and the tour's report read them, and from a string), and tools/grading/build_and_run.py
 list_cases
 (the XML of --list-test-cases, read from the test program's stdout; its sandbox run is
 replaced by one whose stdout is the input, as raw bytes).
@@ -35,10 +35,10 @@ sys.path.insert(0, ROOT)  # the tools package, imported from the repository root
 from tools.grading import exercises  # noqa: E402
 
 try:
-    from tools.grading import grade  # noqa: E402
+    from tools.grading import box, build_and_run, sandbox  # noqa: E402
 except Exception as e:  # a starter kit has no grader: fuzz what exists
-    grade = None
-    print(f"fuzz_results: tools/grading/grade.py not imported ({e}); list_cases not fuzzed", file=sys.stderr)
+    build_and_run = None
+    print(f"fuzz_results: tools/grading/build_and_run.py not imported ({e}); list_cases not fuzzed", file=sys.stderr)
 
 CORPUS = os.path.join(HERE, "corpus", "results")
 TIME_LIMIT = 30.0  # seconds per input: longer is a hang, as in fuzz/fuzz.sh
@@ -112,30 +112,30 @@ def _check_cases(results, how):
 
 
 class _FakeSandboxRun:
-    """grade.sandbox.run for list_cases: the test program 'prints' the input (raw bytes, as
+    """sandbox.run for list_cases: the test program 'prints' the input (raw bytes, as
     the sandbox returns them) and exits 0."""
 
     def __init__(self, data):
         self.data = data
 
     def __call__(self, cmd, limits, **kwargs):
-        return grade.sandbox.Result("ok", "ok", 0, self.data, b"", 0.0)
+        return sandbox.Result("ok", "ok", 0, self.data, b"", 0.0)
 
 
 def _check_list(data, workdir):
-    if grade is None or not hasattr(grade, "list_cases"):
+    if build_and_run is None:
         return
-    real = grade.sandbox.run
-    grade.sandbox.run = _FakeSandboxRun(data)
-    limits = grade.sandbox.Limits()
-    iso = grade.Isolation(False, limits, limits)
+    real = sandbox.run
+    sandbox.run = _FakeSandboxRun(data)
+    limits = sandbox.Limits()
+    iso = box.Isolation(False, limits, limits)
     try:
-        cases = grade.list_cases(os.path.join(workdir, "build", "tests", "test_program"), iso,
-                                 os.path.join(workdir, "list"))
+        cases = build_and_run.list_cases(os.path.join(workdir, "build", "tests", "test_program"), iso,
+                                         os.path.join(workdir, "list"))
     except RuntimeError:
         return
     finally:
-        grade.sandbox.run = real
+        sandbox.run = real
     if not isinstance(cases, list) or not all(
             isinstance(c, tuple) and len(c) == 2 and all(isinstance(x, str) for x in c) for c in cases):
         raise BrokenPromise("list_cases returned something else than [(suite, name)]")

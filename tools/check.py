@@ -29,6 +29,7 @@ import tempfile
 import time
 import xml.etree.ElementTree as ET
 
+from . import build as building
 from .grading import ROOT
 from .grading.exercises import MAX_RESULT_BYTES, exercises as marked_exercises, step_dirs
 
@@ -80,67 +81,29 @@ def step_name(root, number):
 
 def first_compile_error(output, root):
     """The compiler's first error as "file:line: message", paths relative to the tree."""
-    for line in output.splitlines():
-        m = re.match(r"(.+?):(\d+):(?:\d+:)?\s*(?:fatal )?error:\s*(.*)", line)
-        if m:
-            path = m.group(1)
-            if os.path.isabs(path):
-                path = os.path.relpath(path, root)
-            path = re.sub(r"^(\.\./)+", "", path)
-            return f"{path}:{m.group(2)}: {m.group(3).strip()}"
-    for line in output.splitlines():
-        if "error" in line.lower():
-            return line.strip()
-    return output.strip().splitlines()[-1] if output.strip() else "the build failed"
+    return building.first_error(output, root, brief=True)
+
+
+def tree_of(root):
+    return building.Tree.of_preset(root, "release")
 
 
 def configure(root):
-    if os.path.exists(os.path.join(root, BUILD, "build.ninja")):
-        return None
-    say("[check] configuring (cmake --preset release; once)")
-    r = subprocess.run(["cmake", "--preset", "release"], cwd=root, capture_output=True, text=True)
-    if r.returncode != 0:
-        return first_compile_error(r.stdout + r.stderr, root)
-    return None
+    """None, or the first error when the tree does not configure."""
+    r = building.configure(tree_of(root), say=lambda text: say(f"[check] {text}"))
+    return None if r.ok else r.error
 
 
 def build_step(root, number, jobs=None):
     """Builds the step's test program (and its program, for the pictures), saying how far it
     has got; None or the first compile error."""
     target = f"test_step{number:02d}"
-    cmd = ["cmake", "--build", BUILD, "--target", target]
-    if jobs:
-        cmd += ["-j", str(jobs)]
     say(f"[check] building step {number:02d} ({target} and what it needs; a first build takes minutes)")
-    started = shown = time.monotonic()
-    tty = sys.stdout.isatty()
-    output, done, total = [], 0, 0
-    p = subprocess.Popen(cmd, cwd=root, stdout=subprocess.PIPE, stderr=subprocess.STDOUT, text=True,
-                         errors="replace")
-    try:
-        for line in p.stdout:
-            output.append(line)
-            m = re.match(r"\[(\d+)/(\d+)\] (?:Building|Linking)", line)
-            if not m:
-                continue
-            done, total = int(m.group(1)), int(m.group(2))
-            if tty:  # one line, rewritten
-                sys.stdout.write(f"\r\033[K[check]   {done}/{total} {line.split(' ', 1)[1].strip()[:60]}")
-                sys.stdout.flush()
-            elif time.monotonic() - shown >= 10:  # a log: a line every 10 s
-                shown = time.monotonic()
-                say(f"[check]   {done}/{total} built")
-        p.wait()
-    except BaseException:
-        p.kill()
-        p.wait()
-        raise
-    if tty and done:
-        sys.stdout.write("\r\033[K")
-    if p.returncode != 0:
-        return first_compile_error("".join(output), root)
-    if done:
-        say(f"[check]   {done} of {total} build steps done in {time.monotonic() - started:.0f} s")
+    r = building.build(tree_of(root), [target], jobs, progress=building.Progress("[check]", sys.stdout))
+    if not r.ok:
+        return r.error
+    if r.steps:
+        say(f"[check]   {r.steps} build steps done in {r.seconds:.0f} s")
     return None
 
 

@@ -1,5 +1,6 @@
-"""Unit tests of tools/grading/grade.py: the reasons a case or a build fails, the points
-table and its files, the hidden tests' names, the grading tree's sync, the deadline."""
+"""Unit tests of tools/grading/grade.py and its modules (build_and_run, grade_report,
+grading_tree, box): the reasons a case or a build fails, the points table and its files, the
+hidden tests' names, the grading tree's sync, the deadline."""
 import json
 import os
 import sys
@@ -10,11 +11,13 @@ import xml.etree.ElementTree as ET
 import scratch  # noqa: F401  (tempfile's folders: one, removed at exit)
 
 sys.path.insert(0, os.path.dirname(os.path.dirname(os.path.dirname(os.path.abspath(__file__)))))
-from tools.grading import class_bench, grade, grade_class, gradescope, sandbox  # noqa: E402
+from tools.grading import (box, build_and_run, class_bench, errors, grade, grade_class, grade_report,  # noqa: E402
+                           gradescope, grading_tree, sandbox)
 sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
 import test_strict_numbers  # noqa: E402
 from tools.grading.exercises import CaseResult, Exercise  # noqa: E402
-from tools.grading.grade import CaseOutcome, case_outcome, exercise_row  # noqa: E402
+from tools.grading.build_and_run import CaseOutcome, case_outcome  # noqa: E402
+from tools.grading.grade_report import exercise_row  # noqa: E402
 
 
 def result(status="ok", reason=None, stdout=b"", stderr=b"", seconds=0.25, code=0):
@@ -59,18 +62,18 @@ class ListedCases(unittest.TestCase):
     def test_the_list(self):
         xml = (b'<doctest><TestSuite><TestCase name="a" testsuite="exercise 1.1"/>'
                b'<TestCase name="b, c" testsuite="core"/></TestSuite></doctest>')
-        self.assertEqual(grade.listed_cases(result(stdout=xml)), [("exercise 1.1", "a"), ("core", "b, c")])
+        self.assertEqual(build_and_run.listed_cases(result(stdout=xml)), [("exercise 1.1", "a"), ("core", "b, c")])
 
     def test_no_list_says_why(self):
         with self.assertRaises(RuntimeError) as e:
-            grade.listed_cases(result("time limit", stdout=b"spinning"))
+            build_and_run.listed_cases(result("time limit", stdout=b"spinning"))
         self.assertEqual(e.exception.args, ("time limit", "time limit (the test program does not list its tests)"))
         with self.assertRaises(RuntimeError) as e:
-            grade.listed_cases(result("failed", "failed: exit 2", stdout=b"\xff\xfe not xml"))
+            build_and_run.listed_cases(result("failed", "failed: exit 2", stdout=b"\xff\xfe not xml"))
         self.assertEqual(e.exception.args, ("failed", "failed: failed: exit 2 (the test program does not list its tests)"))
 
     def test_doctest_filters_escape_commas(self):
-        self.assertEqual(grade.doctest_filter("a, b,c"), "a\\, b\\,c")
+        self.assertEqual(build_and_run.doctest_filter("a, b,c"), "a\\, b\\,c")
 
 
 SRC = "/work/grade/src"
@@ -82,20 +85,20 @@ class BuildReasons(unittest.TestCase):
                f"{SRC}/steps/01_x/x.cpp:12:5: warning: unused variable\n"
                f"{SRC}/steps/01_x/x.cpp:40:1: error: expected ';' before '}}' token\n"
                f"{SRC}/steps/01_x/x.cpp:41:1: error: a second one\n")
-        self.assertEqual(grade.first_error(log, SRC), "steps/01_x/x.cpp:40:1: error: expected ';' before '}' token")
+        self.assertEqual(build_and_run.first_error(log, SRC), "steps/01_x/x.cpp:40:1: error: expected ';' before '}' token")
 
     def test_the_linkers_error_then_ninjas_line(self):
-        self.assertEqual(grade.first_error("x.o: undefined reference to `f()'\n", SRC), "x.o: undefined reference to `f()'")
-        self.assertEqual(grade.first_error("FAILED: tests/test_step01\n", SRC), "FAILED: tests/test_step01")
-        self.assertEqual(grade.first_error("nothing useful\n", SRC), "the build failed")
+        self.assertEqual(build_and_run.first_error("x.o: undefined reference to `f()'\n", SRC), "x.o: undefined reference to `f()'")
+        self.assertEqual(build_and_run.first_error("FAILED: tests/test_step01\n", SRC), "FAILED: tests/test_step01")
+        self.assertEqual(build_and_run.first_error("nothing useful\n", SRC), "the build failed")
 
     def test_a_limit_names_the_source_being_compiled(self):
         log = f"[2/9] g++ -O1 -c {SRC}/steps/01_x/a.cpp -o a.o\n[3/9] g++ -c {SRC}/steps/01_x/b.cpp -o b.o\n"
-        self.assertEqual(grade.build_reason(result("memory limit"), log, SRC),
+        self.assertEqual(build_and_run.build_reason(result("memory limit"), log, SRC),
                          "does not compile: memory limit (compiling steps/01_x/b.cpp)")
-        self.assertEqual(grade.build_reason(result("time limit", seconds=901.4), log, SRC),
+        self.assertEqual(build_and_run.build_reason(result("time limit", seconds=901.4), log, SRC),
                          "does not compile: time limit (compiling steps/01_x/b.cpp) (the build ran over 901 s)")
-        self.assertEqual(grade.build_reason(result("failed", "failed: exit 1"), f"{SRC}/x.cpp:1: error: no\n", SRC),
+        self.assertEqual(build_and_run.build_reason(result("failed", "failed: exit 1"), f"{SRC}/x.cpp:1: error: no\n", SRC),
                          "does not compile: x.cpp:1: error: no")
 
 
@@ -128,7 +131,7 @@ class PointsTable(unittest.TestCase):
 
     def test_the_printed_table(self):
         with tempfile.TemporaryFile("w+") as out:
-            self.assertEqual(grade.print_table(table_rows(), ["a note"], out), (1, 10))
+            self.assertEqual(grade_report.print_table(table_rows(), ["a note"], out), (1, 10))
             out.seek(0)
             text = out.read()
         self.assertEqual(text.split("\n"), [
@@ -143,14 +146,14 @@ class PointsTable(unittest.TestCase):
     def test_json_and_junit_files(self):
         folder = tempfile.mkdtemp()
         rows = table_rows()
-        grade.write_json(os.path.join(folder, "g.json"), rows, ["n"], 12.345)
+        grade_report.write_json(os.path.join(folder, "g.json"), rows, ["n"], 12.345)
         with open(os.path.join(folder, "g.json")) as f:
             doc = json.load(f)
         self.assertEqual((doc["points"], doc["max"], doc["seconds"], doc["notes"]), (1, 10, 12.35, ["n"]))
         self.assertEqual(doc["exercises"][1], {"exercise": "1.2", "title": "a root", "step": "01", "points": 0,
                                                "max": 2, "status": "failed", "reason": "failed: CHECK( x )",
                                                "case": "edge", "seconds": 0.75})
-        grade.write_junit(os.path.join(folder, "g.xml"), rows, ["n"], 12.3)
+        grade_report.write_junit(os.path.join(folder, "g.xml"), rows, ["n"], 12.3)
         root = ET.parse(os.path.join(folder, "g.xml")).getroot()
         self.assertEqual((root.get("tests"), root.get("failures")), ("4", "3"))
         step1 = root.find("testsuite[@name='step 01']")
@@ -163,7 +166,7 @@ class PointsTable(unittest.TestCase):
         self.assertEqual(failure.get("message"), 'failed: CHECK( x ) (test case "edge")')
 
     def test_results_by_exercise(self):
-        got = grade.results_by_exercise(table_rows())
+        got = grade_report.results_by_exercise(table_rows())
         self.assertEqual(got[0], {"exercise": "1.1", "title": "a sum", "step": "01", "max": 1, "passed": True,
                                   "points": 1, "status": "passed", "reason": "", "seconds": 1.0,
                                   "details": ["passed: fine", "passed: fine"]})
@@ -175,7 +178,7 @@ class StudentText(unittest.TestCase):
     HOSTILE = "a\x1b[31mred\x00\x07\x0b\x0c\r\x7f\x85\ufffe\uffff\ud800 tab\tnewline\n\u00e9"
 
     def test_what_xml_forbids_and_terminals_obey_is_written_out(self):
-        self.assertEqual(grade.printable(self.HOSTILE),
+        self.assertEqual(grade_report.printable(self.HOSTILE),
                          "a\\x1b[31mred\\x00\\x07\\x0b\\x0c\\x0d\\x7f\\x85\\ufffe\\uffff\\ud800 tab\tnewline\n\u00e9")
 
     def test_the_reports_stay_well_formed(self):
@@ -183,12 +186,12 @@ class StudentText(unittest.TestCase):
         o = CaseOutcome("edge " + self.HOSTILE, "failed", "failed: threw: " + self.HOSTILE, 0.5)
         rows = [exercise_row(e, "01", "", [o], 0.5)]
         folder = tempfile.mkdtemp()
-        grade.write_junit(os.path.join(folder, "g.xml"), rows, ["note " + self.HOSTILE], 1.0)
+        grade_report.write_junit(os.path.join(folder, "g.xml"), rows, ["note " + self.HOSTILE], 1.0)
         root = ET.parse(os.path.join(folder, "g.xml")).getroot()  # raises when not well-formed
         failure = root.find(".//failure")
         self.assertIn("\\x1b[31mred", failure.get("message"))
         self.assertIn("\\x00", failure.text)
-        grade.write_json(os.path.join(folder, "g.json"), rows, ["note " + self.HOSTILE], 1.0)
+        grade_report.write_json(os.path.join(folder, "g.json"), rows, ["note " + self.HOSTILE], 1.0)
         with open(os.path.join(folder, "g.json"), encoding="utf-8") as f:
             doc = json.load(f)
         self.assertNotRegex(doc["exercises"][0]["reason"], "[\x00-\x08\x0b-\x1f\x7f\ufffe\ud800]")
@@ -199,21 +202,21 @@ class GradingTree(unittest.TestCase):
         hidden = tempfile.mkdtemp()
         for name in ("step01_extra.cpp", "test_step02.cpp", "notes.txt"):
             open(os.path.join(hidden, name), "w").close()
-        self.assertEqual(grade.hidden_tests(hidden, {"01", "02"}),
+        self.assertEqual(grading_tree.hidden_tests(hidden, {"01", "02"}),
                          {"01": ["step01_extra.cpp"], "02": ["test_step02.cpp"]})
-        self.assertEqual(grade.hidden_tests(None, {"01"}), {})
+        self.assertEqual(grading_tree.hidden_tests(None, {"01"}), {})
         open(os.path.join(hidden, "step07.cpp"), "w").close()
-        with self.assertRaisesRegex(grade.GradeError, "hidden test step07.cpp: name it stepNN"):
-            grade.hidden_tests(hidden, {"01", "02"})
-        with self.assertRaisesRegex(grade.GradeError, "no such folder"):
-            grade.hidden_tests(os.path.join(hidden, "missing"), {"01"})
+        with self.assertRaisesRegex(errors.GradeError, "hidden test step07.cpp: name it stepNN"):
+            grading_tree.hidden_tests(hidden, {"01", "02"})
+        with self.assertRaisesRegex(errors.GradeError, "no such folder"):
+            grading_tree.hidden_tests(os.path.join(hidden, "missing"), {"01"})
 
     def test_sync_keeps_unchanged_files_and_removes_others(self):
         dest = tempfile.mkdtemp()
-        grade.sync_tree(dest, {"a/x.cpp": b"1", "a/y.cpp": b"2", "b/z.cpp": b"3"})
+        grading_tree.sync_tree(dest, {"a/x.cpp": b"1", "a/y.cpp": b"2", "b/z.cpp": b"3"})
         old = os.path.join(dest, "a", "x.cpp")
         os.utime(old, (1, 1))
-        grade.sync_tree(dest, {"a/x.cpp": b"1", "a/y.cpp": b"changed"})
+        grading_tree.sync_tree(dest, {"a/x.cpp": b"1", "a/y.cpp": b"changed"})
         self.assertEqual(os.stat(old).st_mtime, 1)  # unchanged: not written, so not rebuilt
         with open(os.path.join(dest, "a", "y.cpp"), "rb") as f:
             self.assertEqual(f.read(), b"changed")
@@ -221,7 +224,7 @@ class GradingTree(unittest.TestCase):
 
     def test_student_code_sees_no_secrets(self):
         os.environ["BOXES_SECRET_TOKEN"] = "x"
-        env = grade.clean_env("/box")
+        env = box.clean_env("/box")
         self.assertNotIn("BOXES_SECRET_TOKEN", env)
         self.assertEqual((env["HOME"], env["TMPDIR"], env["MALLOC_ARENA_MAX"]), ("/box", "/tmp", "2"))
         self.assertLessEqual(set(env), {"PATH", "LANG", "LC_ALL", "CC", "CXX", "TZ", "HOME", "TMPDIR", "MALLOC_ARENA_MAX"})
@@ -241,21 +244,21 @@ class Deadline(unittest.TestCase):
         sandbox.run = self.real
 
     def test_a_run_gets_the_time_left(self):
-        iso = grade.Isolation(False, sandbox.Limits(900), sandbox.Limits(60), deadline=time.monotonic() + 30)
-        grade.sandboxed(["x"], iso.test, iso)
+        iso = box.Isolation(False, sandbox.Limits(900), sandbox.Limits(60), deadline=time.monotonic() + 30)
+        box.sandboxed(["x"], iso.test, iso)
         self.assertTrue(29 < self.calls[0] <= 30, self.calls)
-        grade.sandboxed(["x"], sandbox.Limits(5), iso)
+        box.sandboxed(["x"], sandbox.Limits(5), iso)
         self.assertEqual(self.calls[1], 5)
 
     def test_no_time_left(self):
-        iso = grade.Isolation(False, sandbox.Limits(900), sandbox.Limits(60), deadline=time.monotonic() - 1)
-        with self.assertRaises(grade.OutOfTime):
-            grade.sandboxed(["x"], iso.test, iso)
+        iso = box.Isolation(False, sandbox.Limits(900), sandbox.Limits(60), deadline=time.monotonic() - 1)
+        with self.assertRaises(errors.OutOfTime):
+            box.sandboxed(["x"], iso.test, iso)
         self.assertEqual(self.calls, [])
 
     def test_no_deadline(self):
-        iso = grade.Isolation(False, sandbox.Limits(900), sandbox.Limits(60))
-        grade.sandboxed(["x"], iso.test, iso)
+        iso = box.Isolation(False, sandbox.Limits(900), sandbox.Limits(60))
+        box.sandboxed(["x"], iso.test, iso)
         self.assertEqual(self.calls, [60])
 
 

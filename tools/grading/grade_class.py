@@ -42,8 +42,10 @@ from .submissions import SubmissionError, content_hash, is_submission, read_subm
 
 CACHE_VERSION = 1
 # What in tools/ decides a grade (besides the reference's sources, tests and CMake files).
-GRADER_FILES = ("tools/grading/grade.py", "tools/grading/exercises.py", "tools/grading/kit.py",
-                "tools/grading/sandbox", "tools/grading/submissions.py")
+GRADER_FILES = ("tools/grading/grade.py", "tools/grading/grade_report.py", "tools/grading/grading_tree.py",
+                "tools/grading/box.py", "tools/grading/build_and_run.py", "tools/grading/errors.py",
+                "tools/grading/exercises.py", "tools/grading/kit.py", "tools/grading/sandbox",
+                "tools/grading/submissions.py")
 
 
 def say(text):

@@ -24,7 +24,8 @@ from .exercises import BEGIN, END, SOURCE_SUFFIXES, exercises, parse_file
 SKIP_DIRS = {".git", "build", "out", "kit", "node_modules", "__pycache__"}
 # The grader's modules: they belong to the instructor's reference tree (they need the
 # solutions). Their end-to-end tests and unit tests stay out with them.
-GRADER = ("grade", "grade_class", "gradescope", "class_bench", "mutants", "safeguards")
+GRADER = ("grade", "grade_report", "grading_tree", "box", "build_and_run", "errors", "grade_class",
+          "gradescope", "class_bench", "mutants", "safeguards")
 NOT_IN_KIT = ({f"tools/grading/{m}.py" for m in GRADER} | {f"tests/tools/test_{m}.py" for m in GRADER}
               | {"tests/grading_test.py", "tests/class_grading_test.py", "tests/check_test.py",
                  "tests/lab_test.py"})

@@ -1,0 +1,17 @@
+"""Why grading one tree stops: GradeError (it cannot start or go on) and OutOfTime (its
+overall deadline passed). Raised by the grading modules, caught by grade.py's callers."""
+
+
+class GradeError(Exception):
+    """Grading cannot start or go on: a bad option, a tree that is not a workbook, the
+    grading tree does not configure, no isolation. The message is one line; `code` is the
+    exit status of ./workbook grade."""
+
+    def __init__(self, message, code=1):
+        super().__init__(message)
+        self.code = code
+
+
+class OutOfTime(Exception):
+    """The whole grading of one tree passed its deadline (the class grader's
+    --student-timeout)."""

@@ -23,7 +23,8 @@ import matplotlib.pyplot as plt  # noqa: E402
 # Its yellow is left out: too faint for a name written in it.
 COLOURS = ["#0072B2", "#D55E00", "#009E73", "#CC79A7", "#E69F00", "#56B4E9", "#000000", "#882255"]
 MARKERS = ["o", "s", "^", "D", "v", "P", "X", "*"]
-SIZE = (8.0, 4.5)  # inches: 16:9, the decks' shape
+SIZE = (6.4, 3.6)  # inches: 16:9, the decks' shape; small, so the letters are large beside it
+matplotlib.rcParams["font.size"] = 10
 matplotlib.rcParams["svg.fonttype"] = "path"  # the same letters in every browser, offline
 matplotlib.rcParams["svg.hashsalt"] = "boxes"  # the same file for the same plot
 
@@ -91,7 +92,7 @@ def _overlaps(a, b, pad=2.0):
     return not (a.x1 + pad < b.x0 or b.x1 + pad < a.x0 or a.y1 + pad < b.y0 or b.y1 + pad < a.y0)
 
 
-def place_labels(fig, ax, points, fontsize=9, lines=(), marker=8):
+def place_labels(fig, ax, points, fontsize=10, lines=(), marker=8):
     """Names beside their points, none over another name or point and all inside the axes:
     for each point the first free spot of a ring of candidates around it, nearest first
     (right, above, left, below, then the diagonals, then further out), with a line back to
@@ -187,15 +188,15 @@ def _bars(table, spec, groups, title):
     colours = [COLOURS[keys.index(next(k for k, g in groups.items() if p in g)) % len(COLOURS)] for p in rows]
     ax.barh(range(len(rows)), values, xerr=errors, color=colours, alpha=0.85, capsize=3,
             error_kw={"lw": 1, "ecolor": "#444"})
-    ax.set_yticks(range(len(rows)), names, fontsize=9)
+    ax.set_yticks(range(len(rows)), names, fontsize=10)
     ax.invert_yaxis()
     for i, v in enumerate(values):  # the median's value right of its bar and whisker
         end = v + (errors[1][i] if errors else 0.0)
-        ax.annotate(f"{v:.3g}", (end, i), textcoords="offset points", xytext=(5, 0), fontsize=8,
+        ax.annotate(f"{v:.3g}", (end, i), textcoords="offset points", xytext=(5, 0), fontsize=9,
                     color="#333", va="center")
     ax.set_xlabel(spec["x"] + (" (bars: median; whiskers: min to max)" if errors else ""))
     ax.set_title(f"{title}\nevery variant exact ({spec['y']} = 0): only the time tells them apart",
-                 fontsize=10, wrap=True)
+                 fontsize=10.5, wrap=True)
     ax.margins(x=0.15)
     ax.grid(True, axis="x", alpha=0.3)
     return fig
@@ -248,8 +249,8 @@ def draw(report, spec):
     ax.set_xlabel(spec["x"])
     ax.set_ylabel(spec["y"])
     if spec.get("pareto"):  # what the line and the rings mean, where a reader looks first
-        title += "\nline: the Pareto front (nothing beats it on both axes); ringed: another is better on both"
-    ax.set_title(title, fontsize=10, wrap=True)
+        title += "\nline: the Pareto front; ringed: another point is better on both axes"
+    ax.set_title(title, fontsize=10.5, wrap=True)
     ax.grid(True, alpha=0.3)
     if named:
         place_labels(fig, ax, [(p[0], p[1], p[2], COLOURS[k % len(COLOURS)])

@@ -13,6 +13,7 @@ import glob
 import json
 import os
 import sys
+import textwrap
 
 import matplotlib
 
@@ -37,6 +38,12 @@ def pareto_front(points):
         if not front or p[1] < front[-1][1]:
             front.append(p)
     return front
+
+
+def fit_title(title, width=70):
+    """The title in lines no wider than the axes, so no plot is drawn smaller on the page
+    for the sake of its title."""
+    return "\n".join(textwrap.fill(line, width) for line in title.split("\n"))
 
 
 def _number(v):
@@ -178,7 +185,7 @@ def _bars(table, spec, groups, title):
     time = table.get("time") or {}
     lo = cols.index(time["low"]) if time.get("low") in cols and time.get("median") == spec["x"] else None
     hi = cols.index(time["high"]) if time.get("high") in cols and time.get("median") == spec["x"] else None
-    fig, ax = plt.subplots(figsize=(SIZE[0], max(2.2, 0.9 + 0.45 * len(rows))), dpi=100)
+    fig, ax = plt.subplots(figsize=SIZE, dpi=100)  # the same size as every plot
     names = [p[2] or spec["x"] for p in rows]
     values = [p[0] for p in rows]
     errors = None
@@ -195,8 +202,8 @@ def _bars(table, spec, groups, title):
         ax.annotate(f"{v:.3g}", (end, i), textcoords="offset points", xytext=(5, 0), fontsize=9,
                     color="#333", va="center")
     ax.set_xlabel(spec["x"] + (" (bars: median; whiskers: min to max)" if errors else ""))
-    ax.set_title(f"{title}\nevery variant exact ({spec['y']} = 0): only the time tells them apart",
-                 fontsize=10.5, wrap=True)
+    ax.set_title(fit_title(f"{title}\nevery variant exact ({spec['y']} = 0): only the time tells them apart"),
+                 fontsize=10.5)
     ax.margins(x=0.15)
     ax.grid(True, axis="x", alpha=0.3)
     return fig
@@ -250,7 +257,7 @@ def draw(report, spec):
     ax.set_ylabel(spec["y"])
     if spec.get("pareto"):  # what the line and the rings mean, where a reader looks first
         title += "\nline: the Pareto front; ringed: another point is better on both axes"
-    ax.set_title(title, fontsize=10.5, wrap=True)
+    ax.set_title(fit_title(title), fontsize=10.5)
     ax.grid(True, alpha=0.3)
     if named:
         place_labels(fig, ax, [(p[0], p[1], p[2], COLOURS[k % len(COLOURS)])
@@ -258,8 +265,13 @@ def draw(report, spec):
                      lines=avoid, marker=11 if spec.get("pareto") else 8)
     # A legend only where colours mean something the names beside the points do not say:
     # the series of a line plot or of several points each.
+    # Below the figure, under the x axis's label (never over it), so every plot keeps the
+    # same width and the same size of letters on the page.
     if any(keys) and (not named or not one_per_series):
-        ax.legend(fontsize=9, loc="upper left", bbox_to_anchor=(1.01, 1.0), frameon=False)
+        fig.tight_layout()
+        fig.legend(*ax.get_legend_handles_labels(), fontsize=9, loc="upper center",
+                   bbox_to_anchor=(0.5, 0.0), frameon=False,
+                   ncol=min(len(keys), 2 if max(len(k) for k in keys) > 12 else 4))
     return fig
 
 

@@ -318,7 +318,7 @@ ul.points{list-style:none;padding-left:0}ul.points li{margin:.45em 0;display:fle
 .agree .mark{color:#1a7f37}.disagree .mark,.error .mark{color:#cf222e}.unchecked .mark,.not-measured .mark{color:#777}
 .gallery,.plots{display:flex;flex-wrap:wrap;gap:12px;align-items:flex-start}
 .gallery figure{margin:0;flex:1 1 300px;max-width:420px}.gallery img{width:100%;border:1px solid #ddd}
-.plots figure{margin:0;flex:1 1 560px;max-width:820px}.plots img{width:100%}
+.plots figure{margin:0;flex:1 1 520px;max-width:580px}.plots img{width:100%}
 figcaption{font-size:88%;color:#444}
 .takeaway{margin:.3em 0;font-size:95%}.takeaway .label{background:#0072B2;color:#fff;border-radius:3px;padding:0 5px;font-size:80%;margin-right:.3em}
 div.table{margin:1em 0}summary{cursor:pointer;font-weight:bold}summary .id{font-weight:normal;color:#777;font-size:85%}

@@ -1,6 +1,7 @@
 #include "exam/questions.hpp"
 
 #include <algorithm>
+#include <cctype>
 #include <cmath>
 #include <functional>
 #include <random>
@@ -12,81 +13,15 @@
 #include "core/math.hpp"
 #include "core/shapes.hpp"
 #include "exam/answer.hpp"
+#include "exam/generate.hpp"
+#include "exam/kinds.hpp"
 #include "exam/reference.hpp"
 
 namespace boxes::exam {
 
-namespace {
+using gen::num;
 
-// Seeded integers that come out the same on every platform (std:: distributions do not).
-struct Rng {
-    std::mt19937_64 engine;
-    explicit Rng(uint64_t seed) : engine(seed * 0x9E3779B97F4A7C15ull + 12345) {}
-    int pick(int lo, int hi) { return lo + int(engine() % uint64_t(hi - lo + 1)); }
-    bool chance(int percent) { return pick(1, 100) <= percent; }
-    Vec3d vec(int lo, int hi) { return Vec3d(pick(lo, hi), pick(lo, hi), pick(lo, hi)); }
-    Vec3d nonZero(int lo, int hi) {
-        for (;;) {
-            Vec3d v = vec(lo, hi);
-            if (!isZero(v)) return v;
-        }
-    }
-    template <typename T>
-    const T& oneOf(const std::vector<T>& items) {
-        return items[size_t(pick(0, int(items.size()) - 1))];
-    }
-};
-
-std::string num(double v) {
-    if (std::abs(v) < 1e-12) v = 0.0;  // no "-0", no rounding noise like 1.1e-16
-    std::ostringstream s;
-    s.precision(6);
-    s << v;
-    return s.str();
-}
-
-std::string vec(const Vec3d& v) {
-    return "(" + num(v.x) + ", " + num(v.y) + ", " + num(v.z) + ")";
-}
-std::vector<double> values(const Vec3d& v) {
-    return {v.x, v.y, v.z};
-}
-
-Part numbersPart(const std::string& prompt, std::vector<double> expected, size_t count,
-                 bool noneAllowed = false) {
-    Part p;
-    p.prompt = prompt;
-    p.expected = std::move(expected);
-    p.count = count;
-    p.noneAllowed = noneAllowed;
-    p.shown = p.expected.empty() ? "none"
-              : count == 1       ? num(p.expected[0])
-                                 : formatNumbers(p.expected);
-    return p;
-}
-
-Part yesNoPart(const std::string& prompt, bool yes) {
-    Part p;
-    p.prompt = prompt + " (yes or no)";
-    p.type = AnswerType::YesNo;
-    p.yes = yes;
-    p.shown = yes ? "yes" : "no";
-    return p;
-}
-
-std::string box(const Bounds3d& b) {
-    return "[" + vec(b.min) + ", " + vec(b.max) + "]";
-}
-
-Bounds3d randomBox(Rng& rng, int lo, int hi) {
-    Bounds3d b;
-    for (int axis = 0; axis < 3; ++axis) {
-        int a = rng.pick(lo, hi - 1);
-        b.min[axis] = a;
-        b.max[axis] = rng.pick(a + 1, std::min(hi, a + 4));
-    }
-    return b;
-}
+namespace gen {
 
 // A camera whose view is never parallel to up, with a field of view and an aspect ratio
 // that give readable numbers.
@@ -223,8 +158,8 @@ Question rayPlane(Rng& rng, Question q) {
                              (denom == 0.0 ? ": the ray is parallel to the plane, no hit" : ""));
         if (denom != 0.0) {
             double tt = -(glm::dot(o, n) + pd) / denom;
-            q.solution.push_back("t = -(O . N + d) / (D . N) = -(" + num(glm::dot(o, n)) + " + " +
-                                 num(pd) + ") / " + num(denom) + " = " + num(tt));
+            q.solution.push_back("t = -(O . N + d) / (D . N) = -(" + num(glm::dot(o, n)) +
+                                 plus(pd) + ") / " + num(denom) + " = " + num(tt));
             q.solution.push_back(tt < 0.0 ? "t < 0: the plane lies behind the ray's origin, no hit"
                                           : "P = O + t D = " + vec(o + tt * d));
         }
@@ -374,8 +309,11 @@ Question rayBox(Rng& rng, Question q) {
         q.given["min"] = values(b.min);
         q.given["max"] = values(b.max);
         q.statement = "A ray starts at O = " + vec(o) + " with direction D = " + vec(d) +
-                      " (hits count for t >= 0). The axis-aligned box is [min, max] = " + box(b) +
-                      ". Use the slab test.";
+                      ", the points O + t D for t in [0, +inf). The axis-aligned box is "
+                      "[min, max] = " +
+                      box(b) +
+                      ". Use the slab test, and give the part of the ray inside the box as "
+                      "exercise 3.6 returns it: the interval clipped to the ray's [0, +inf).";
         const char* names = "xyz";
         for (int axis = 0; axis < 3; ++axis) {
             std::string n(1, names[axis]);
@@ -393,26 +331,22 @@ Question rayBox(Rng& rng, Question q) {
                                  ", " + num(std::max(t0, t1)) + "]");
         }
         q.solution.push_back(
-            "t_enter = the largest entry, t_exit = the smallest exit; a hit when t_enter <= t_exit "
-            "and t_exit >= 0");
+            "the line is inside the box for t from the largest entry to the smallest exit; "
+            "clipped to the ray's [0, +inf): t_enter = max(0, largest entry), t_exit = smallest "
+            "exit; a hit when t_enter <= t_exit");
+        double enter = hit ? std::max(0.0, hit->enter) : 0.0;
         q.solution.push_back(
-            hit ? "t_enter = " + num(hit->enter) + ", t_exit = " + num(hit->exit) +
-                      (hit->enter < 0 ? " (t_enter < 0: the origin is inside the box)" : "")
+            hit ? "t_enter = " + num(enter) + ", t_exit = " + num(hit->exit) +
+                      (hit->enter < 0 ? " (the largest entry, " + num(hit->enter) +
+                                            ", is behind the origin: O is inside the box, and "
+                                            "the ray's part inside starts at t = 0)"
+                                      : "")
                 : "no hit");
         q.parts.push_back(numbersPart(
-            "t_enter and t_exit of the slab test, or 'none'",
-            hit ? std::vector<double>{hit->enter, hit->exit} : std::vector<double>{}, 2, true));
+            "t_enter and t_exit of the ray's part inside the box, or 'none'",
+            hit ? std::vector<double>{enter, hit->exit} : std::vector<double>{}, 2, true));
         return q;
     }
-}
-
-// Unit normals with short exact forms.
-Vec3d niceNormal(Rng& rng) {
-    static const std::vector<Vec3d> normals = {{0, 1, 0}, {1, 0, 0}, {0, 0, 1}, {1, 2, 2},
-                                               {2, 3, 6}, {0, 3, 4}, {3, 4, 0}, {1, 1, 0}};
-    Vec3d n = glm::normalize(rng.oneOf(normals));
-    if (rng.chance(50)) n = -n;
-    return n;
 }
 
 Question reflection(Rng& rng, Question q) {
@@ -575,14 +509,6 @@ Question frustumCull(Rng& rng, Question q) {
     return q;
 }
 
-// The lecture's terms, each asked by what it means; an answer must name one word of every
-// keyword group (lower case, found anywhere in the answer).
-struct Term {
-    std::string term, question;
-    std::vector<std::vector<std::string>> keywords;
-    std::string explanation;
-};
-
 const std::vector<Term>& terms() {
     static const std::vector<Term> list = {
         {"AABB",
@@ -681,36 +607,31 @@ const std::vector<Term>& terms() {
     return list;
 }
 
+Question termQuestion(const Term& t, Question q) {
+    q.statement = t.question;
+    q.parts.push_back(wordsPart("the term", t.keywords, t.term));
+    q.solution = {t.explanation};
+    return q;
+}
+
+Question glassQuestion(Question q) {
+    q.statement = "Glass causes two types of scattering. Name both.";
+    q.parts.push_back(wordsPart("the two types of scattering that glass causes",
+                                {{"reflect"}, {"refract", "transmi"}},
+                                "reflection and refraction"));
+    q.solution = {
+        "At a glass surface part of the light is reflected (mirror direction, Fresnel "
+        "reflectance) and the rest refracted (transmitted, bent by Snell's law).",
+        "A Whitted ray tracer follows both: a reflection ray and a refraction ray."};
+    return q;
+}
+
 Question terminology(Rng& rng, Question q) {
     // One of the lecture's terms, the glass question of its example exam, or the choice
     // question on what conservative means.
     int pick = rng.pick(0, int(terms().size()) + 1);
-    if (pick < int(terms().size())) {
-        const Term& t = terms()[size_t(pick)];
-        q.statement = t.question;
-        Part p;
-        p.prompt = "the term";
-        p.type = AnswerType::Words;
-        p.keywords = t.keywords;
-        p.shown = t.term;
-        q.parts.push_back(p);
-        q.solution = {t.explanation};
-        return q;
-    }
-    if (pick == int(terms().size())) {
-        q.statement = "Glass scatters light in two ways. Name both.";
-        Part p;
-        p.prompt = "the two kinds of scattering that glass causes";
-        p.type = AnswerType::Words;
-        p.keywords = {{"reflect"}, {"refract", "transmi"}};
-        p.shown = "reflection and refraction";
-        q.parts.push_back(p);
-        q.solution = {
-            "At a glass surface part of the light is reflected (mirror direction, Fresnel "
-            "reflectance) and the rest refracted (transmitted, bent by Snell's law).",
-            "A Whitted ray tracer follows both: a reflection ray and a refraction ray."};
-        return q;
-    }
+    if (pick < int(terms().size())) return termQuestion(terms()[size_t(pick)], std::move(q));
+    if (pick == int(terms().size())) return glassQuestion(std::move(q));
     std::vector<std::string> options = {
         "it never removes an object that is visible, but may keep some that are not",
         "it removes every invisible object, but may also remove some visible ones",
@@ -779,7 +700,18 @@ Question workedExample(Rng&, Question q) {
     return q;
 }
 
-using Generator = std::function<Question(Rng&, Question)>;
+}  // namespace gen
+
+namespace {
+
+using namespace gen;
+
+using Generator = std::function<Question(Rng&, Question, const MeasuredCosts&)>;
+// Most kinds need only their seeded numbers.
+template <Question (*make)(Rng&, Question)>
+Question seeded(Rng& rng, Question q, const MeasuredCosts&) {
+    return make(rng, std::move(q));
+}
 struct KindEntry {
     QuestionKind kind;
     Generator make;
@@ -787,34 +719,68 @@ struct KindEntry {
 
 const std::vector<KindEntry>& kindTable() {
     static const std::vector<KindEntry> table = {
-        {{"vectors", "dot and cross products and normalization"}, vectors},
+        {{"vectors", "dot and cross products and normalization"}, seeded<vectors>},
         {{"screen-corners",
           "the camera's virtual screen corners from eye, view, up, fov and aspect"},
-         screenCorners},
+         seeded<screenCorners>},
         {{"primary-ray", "a primary ray's normalized direction through a pixel centre"},
-         primaryRay},
-        {{"ray-plane", "a ray's hit point with a plane N.P + d = 0"}, rayPlane},
-        {{"ray-sphere", "a ray's nearest hit on a sphere and the normal there"}, raySphere},
+         seeded<primaryRay>},
+        {{"ray-plane", "a ray's hit point with a plane N.P + d = 0"}, seeded<rayPlane>},
+        {{"ray-sphere", "a ray's nearest hit on a sphere and the normal there"}, seeded<raySphere>},
         {{"ray-triangle", "t and the barycentrics (u, v) of a ray/triangle hit"},
-         rayTriangleQuestion},
-        {{"ray-box", "the slab test: t_enter and t_exit of a ray and an axis-aligned box"}, rayBox},
-        {{"reflect", "a mirror reflection direction"}, reflection},
+         seeded<rayTriangleQuestion>},
+        {{"ray-box",
+          "the slab test: the interval [t_enter, t_exit] of a ray (t >= 0) inside an "
+          "axis-aligned box, clipped as exercise 3.6 does"},
+         seeded<rayBox>},
+        {{"reflect", "a mirror reflection direction"}, seeded<reflection>},
         {{"refract", "a refraction direction by Snell's law, or total internal reflection"},
-         refraction},
-        {{"fresnel", "reflectance by Schlick's approximation"}, fresnel},
-        {{"aabb-points", "the axis-aligned bounding box of a set of points"}, aabbPoints},
-        {{"aabb-union", "the union of two axis-aligned boxes"}, aabbUnion},
-        {{"aabb-overlap", "whether two closed axis-aligned boxes overlap"}, aabbOverlap},
+         seeded<refraction>},
+        {{"fresnel", "reflectance by Schlick's approximation"}, seeded<fresnel>},
+        {{"aabb-points", "the axis-aligned bounding box of a set of points"}, seeded<aabbPoints>},
+        {{"aabb-union", "the union of two axis-aligned boxes"}, seeded<aabbUnion>},
+        {{"aabb-overlap", "whether two closed axis-aligned boxes overlap"}, seeded<aabbOverlap>},
         {{"frustum-cull", "the single-vertex (p-vertex) test of a box against a frustum plane"},
-         frustumCull},
+         seeded<frustumCull>},
+        {{"light-shading",
+          "light transport: diffuse shading of a point by a point light, N.L and the 1/d^2 "
+          "falloff"},
+         seeded<lightShading>},
+        {{"shadow-ray",
+          "light transport: is the point in shadow? a shadow ray towards the light and one "
+          "sphere"},
+         seeded<shadowRay>},
+        {{"ray-depth",
+          "light transport: the reflected and refracted rays at each depth of a ray through "
+          "a glass slab"},
+         seeded<rayDepth>},
+        {{"slide-union",
+          "what the lecture's union code returns for two boxes, printed as on the slide"},
+         seeded<slideUnion>},
+        {{"slide-slab",
+          "what the lecture's slab test returns for a ray and a box: its formulas or its "
+          "pseudo-code, printed as on the slides"},
+         seeded<slideSlab>},
+        {{"cost-order",
+          "the cost of sin, sqrt, /, *, + as your run of step 05 measured them, and the "
+          "sine table against std::sin"},
+         costOrder},
         {{"terminology",
           "the lecture's terms (AABB, slab test, frustum, false negatives, global data, ...); "
           "conservative culling; the two kinds of scattering glass causes"},
-         terminology},
+         seeded<terminology>},
+        {{"example-1a",
+          "the example exam's question 1a: the four corners of the virtual screen (seed 0: "
+          "its own E = (1,1,1), V = (1,0,1))"},
+         seeded<exampleCorners>},
+        {{"example-1b",
+          "the example exam's question 1b: the normalized direction of the ray r (seed 0: "
+          "its own numbers)"},
+         seeded<exampleDirection>},
         {{"worked-example",
           "the lecture's example exam, question 1: E = (1,1,1), V = (1,0,1), the sphere "
           "|p - C| = sqrt(20)"},
-         workedExample},
+         seeded<workedExample>},
     };
     return table;
 }
@@ -823,7 +789,7 @@ const std::vector<KindEntry>& kindTable() {
 
 std::vector<std::string> terminologyTerms() {
     std::vector<std::string> names;
-    for (const Term& t : terms()) names.push_back(t.term);
+    for (const gen::Term& t : gen::terms()) names.push_back(t.term);
     return names;
 }
 
@@ -836,14 +802,14 @@ const std::vector<QuestionKind>& questionKinds() {
     return kinds;
 }
 
-Question makeQuestion(const std::string& kind, uint64_t seed) {
+Question makeQuestion(const std::string& kind, uint64_t seed, const MeasuredCosts& costs) {
     for (const KindEntry& e : kindTable()) {
         if (e.kind.name != kind) continue;
         Rng rng(seed);
         Question q;
         q.kind = kind;
         q.seed = seed;
-        return e.make(rng, std::move(q));
+        return e.make(rng, std::move(q), costs);
     }
     std::string names;
     for (const QuestionKind& k : questionKinds()) names += (names.empty() ? "" : ", ") + k.name;
@@ -879,6 +845,27 @@ Checked checkAnswer(const Part& part, const std::string& answer) {
                 if (!found) return {Verdict::Wrong, "'" + group[0] + "...' is missing"};
             }
             return {Verdict::Correct, ""};
+        }
+        case AnswerType::Order: {
+            // "c a b", "c, a, b", "cab", "c < a < b": the letters, in order.
+            std::string letters;
+            for (char c : a)
+                if (std::isalpha(static_cast<unsigned char>(c))) letters += c;
+            std::string wanted = part.order;
+            std::sort(wanted.begin(), wanted.end());
+            std::string given = letters;
+            std::sort(given.begin(), given.end());
+            if (given != wanted) {
+                std::string names;
+                for (size_t i = 0; i < wanted.size(); ++i)
+                    names += (i == 0                   ? ""
+                              : i + 1 == wanted.size() ? " and "
+                                                       : ", ") +
+                             std::string(1, wanted[i]);
+                return {Verdict::Unreadable,
+                        "give each of the letters " + names + " once, in order"};
+            }
+            return {letters == part.order ? Verdict::Correct : Verdict::Wrong, ""};
         }
         case AnswerType::Numbers:
             break;

@@ -14,6 +14,7 @@ enum class AnswerType {
     YesNo,
     Choice,  // a letter a, b, c, ...
     Words,   // every keyword group must be named
+    Order,   // letters in order, "c a b"
 };
 
 struct Part {
@@ -24,6 +25,7 @@ struct Part {
     bool noneAllowed = false;      // Numbers: "none" is a possible answer
     bool yes = false;              // YesNo
     char choice = 'a';             // Choice
+    std::string order;             // Order: the letters in the right order, "cab"
     std::vector<std::vector<std::string>> keywords;  // Words: one word of every group
     std::string shown;                               // the answer as the solution writes it
 };
@@ -45,10 +47,34 @@ struct QuestionKind {
 // Every kind of question, in the order --list shows them.
 const std::vector<QuestionKind>& questionKinds();
 
+// One operation's time from step 05's table op_cost.
+struct OpCost {
+    std::string op, type;  // "sqrt", "float"
+    double ns = 0.0;       // the median ns per operation
+};
+
+// What one run of step 05's lab measured that the kind "cost-order" asks about: the cost of
+// each operation of the lecture's list (table op_cost), and the nearest entry of a 3600-entry
+// sine table against std::sin in float (table sincos).
+struct MeasuredCosts {
+    std::string source;  // where the figures come from, as the question names it
+    std::vector<OpCost> ops;
+    double tableNs = 0.0, stdSinNs = 0.0;
+};
+
+// The figures of one run of step 05 on a 2-thread x86-64 machine, for a student who has not
+// run the lab yet (and for printed sheets, the same on every machine).
+const MeasuredCosts& referenceCosts();
+
+// The figures of a step 05 report (`05_efficiency --measure --report FILE`, the tour's
+// out/05_efficiency.json). Throws std::runtime_error naming what is missing or unreadable.
+MeasuredCosts readMeasuredCosts(const std::string& path);
+
 // The question of one kind for one seed (the same seed gives the same numbers). The kind
-// "worked-example" is the lecture's example exam's first question, with fixed numbers. Throws std::invalid_argument for an
-// unknown kind.
-Question makeQuestion(const std::string& kind, uint64_t seed);
+// "worked-example" is the lecture's example exam's first question, with fixed numbers;
+// "cost-order" asks about `costs`. Throws std::invalid_argument for an unknown kind.
+Question makeQuestion(const std::string& kind, uint64_t seed,
+                      const MeasuredCosts& costs = referenceCosts());
 
 // The lecture's terms that the kind "terminology" asks for (besides the glass and the
 // conservative-culling questions), as the solution names them.

@@ -544,7 +544,7 @@ TEST_SUITE("program 03") {
     TEST_CASE("bad input: one clear line and a non-zero exit") {
         test::TempDir dir;
         test::checkBadInput(program, dir,
-                            {{"--scene nosuchscene", "unknown scene", 1},
+                            {{"--scene nosuchscene", "unknown scene", 2},
                              {"--pretest maybe", "pretest", 2},
                              {"--spheres -3", "spheres", 2},
                              {"--frobnicate", "frobnicate", 2},

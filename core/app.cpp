@@ -4,28 +4,15 @@
 #include <cmath>
 #include <cstdlib>
 #include <iostream>
-#include <sstream>
 
 #include "core/exercise.hpp"
 #include "core/mesh.hpp"
-#include "core/timing.hpp"
 
 #ifndef BOXES_DATA_DIR
 #define BOXES_DATA_DIR "data"
 #endif
 
 namespace boxes {
-
-WindowOptions CommonOptions::windowOptions(const std::string& title) const {
-    WindowOptions w;
-    w.title = title;
-    w.scriptedFrames = frames;
-    std::stringstream list(keys);
-    for (std::string key; std::getline(list, key, ',');)
-        if (!key.empty()) w.scriptedKeys.push_back(key);
-    w.screenshotPath = screenshot;
-    return w;
-}
 
 RenderSettings CommonOptions::renderSettings() const {
     RenderSettings s;
@@ -202,49 +189,6 @@ int runMain(const std::string& program, const std::function<int()>& body) {
     } catch (const std::exception& e) {
         return fail(std::string("error: ") + e.what(), 1);
     }
-}
-
-std::string headlessPath(const CommonOptions& o, const std::string& program) {
-    return o.out.empty() ? program + ".png" : o.out;
-}
-
-Image renderHeadlessImage(const Scene& scene, const Camera& camera, RenderSettings settings,
-                          const std::string& png, const std::string& caption, Report& report,
-                          RayCounts* counts) {
-    settings.progressLabel = report.program + ": rendering";
-    RayCounts ownCounts;
-    if (!counts) counts = &ownCounts;
-    Stopwatch watch;
-    Image image = renderImage(scene, camera, settings, counts);
-    double seconds = watch.seconds();
-    image.writePng(png);
-    report.images.push_back({png, caption});
-    report.facts["render_ms"] = seconds * 1e3;
-    report.facts["rays"] = counts->total();
-    std::cerr << report.program << ": wrote " << png << " (" << image.width() << "x"
-              << image.height() << ", " << formatSeconds(seconds) << ")\n";
-    return image;
-}
-
-void writeReport(const Report& report, const CommonOptions& o) {
-    report.write(o.json ? std::cerr : std::cout, o.json ? "-" : o.reportPath);
-    if (o.json && !o.reportPath.empty()) report.write(std::cerr, o.reportPath);
-}
-
-std::string pngStem(const std::string& png) {
-    return png.size() > 4 && png.ends_with(".png") ? png.substr(0, png.size() - 4) : png;
-}
-
-std::string pngWithSuffix(const std::string& png, const std::string& suffix) {
-    return pngStem(png) + suffix + ".png";
-}
-
-bool displayAvailable() {
-    for (const char* var : {"DISPLAY", "WAYLAND_DISPLAY", "SDL_VIDEODRIVER"}) {
-        const char* v = std::getenv(var);
-        if (v && *v) return true;
-    }
-    return false;
 }
 
 }  // namespace boxes

@@ -1,5 +1,6 @@
-// The program shell every step uses: common flags, camera flags, one-line errors and
-// exit codes, and the choice between a window and the headless path.
+// The command line every program of the workbook shares: the common flags and the camera
+// flags, strict numbers, one-line errors and exit codes. What the flags then do is the step
+// shell's (core/step.hpp).
 #pragma once
 
 #include <CLI/CLI.hpp>
@@ -10,9 +11,7 @@
 
 #include "core/camera.hpp"
 #include "core/render.hpp"
-#include "core/report.hpp"
 #include "core/scene.hpp"
-#include "core/window.hpp"
 
 namespace boxes {
 
@@ -35,7 +34,6 @@ struct CommonOptions {
     std::string screenshot;
 
     float aspect() const { return float(width) / float(height); }
-    WindowOptions windowOptions(const std::string& title) const;
     // --width --height --threads --seed as render settings.
     RenderSettings renderSettings() const;
 };
@@ -63,30 +61,5 @@ Scene sceneFromOptions(const CommonOptions& options);
 // Runs body and turns every error into one line on stderr and an exit code:
 // 0 success, 1 bad input or failure, 2 bad command line, 3 an exercise not implemented.
 int runMain(const std::string& program, const std::function<int()>& body);
-
-// ---- The headless path (--headless): one image, its report --------------------------
-
-// The headless PNG: --out, else PROGRAM.png.
-std::string headlessPath(const CommonOptions& options, const std::string& program);
-
-// Renders `camera`'s view of the scene (progress on stderr), writes it to `png`, records it
-// in the report (the image with its caption, render_ms, rays; counts when asked) and prints
-// "PROGRAM: wrote PNG (WxH, time)" on stderr, PROGRAM being report.program.
-Image renderHeadlessImage(const Scene& scene, const Camera& camera, RenderSettings settings,
-                          const std::string& png, const std::string& caption, Report& report,
-                          RayCounts* counts = nullptr);
-
-// The tables on stdout and the JSON to --report; with --json the JSON on stdout and the
-// tables (and the JSON to --report) on stderr, so stdout stays one JSON document.
-void writeReport(const Report& report, const CommonOptions& options);
-
-// The headless PNG's companions: pngStem("a.png") is "a", pngWithSuffix("a.png", "-cull")
-// is "a-cull.png".
-std::string pngStem(const std::string& png);
-std::string pngWithSuffix(const std::string& png, const std::string& suffix);
-
-// True when a window can probably be opened (DISPLAY, WAYLAND_DISPLAY, or an explicit
-// SDL_VIDEODRIVER).
-bool displayAvailable();
 
 }  // namespace boxes

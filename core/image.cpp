@@ -64,6 +64,14 @@ void appendToVector(void* context, void* data, int size) {
 }
 }  // namespace
 
+std::string pngStem(const std::string& png) {
+    return png.size() > 4 && png.ends_with(".png") ? png.substr(0, png.size() - 4) : png;
+}
+
+std::string pngWithSuffix(const std::string& png, const std::string& suffix) {
+    return pngStem(png) + suffix + ".png";
+}
+
 void writeFileAtomically(const std::string& path, const void* data, size_t size) {
     std::string tmp = temporaryNameFor(path);
     {

@@ -55,6 +55,11 @@ ImageDifference compareImages(const Image& a, const Image& b, float threshold = 
 // Returns the number of marked pixels.
 size_t markPixels(Image& image, const std::vector<uint8_t>& marked, Vec3 colour);
 
+// A PNG's companions: pngStem("a.png") is "a", pngWithSuffix("a.png", "-cull") is
+// "a-cull.png".
+std::string pngStem(const std::string& png);
+std::string pngWithSuffix(const std::string& png, const std::string& suffix);
+
 // Writes a file through a temporary name and a rename (no partial files).
 void writeFileAtomically(const std::string& path, const void* data, size_t size);
 

@@ -1,8 +1,9 @@
 // The step shell. A step program describes itself in a StepProgram (its name, its flags,
 // its scene and geometry, what it measures, its keys and panel) and hands it to runStep,
-// which does the rest the same way for every step: the command line, then either the
-// headless image with its report, or the window. runStep (core/step.cpp) reads from top to
-// bottom as the main of every step program.
+// which does the rest the same way for every step: the command line (core/app.hpp), then
+// either the headless image, the measurements of --measure and the report (core/step.cpp),
+// or the window (core/step_window.cpp). runStep reads from top to bottom as the main of
+// every step program.
 #pragma once
 
 #include <CLI/CLI.hpp>
@@ -12,16 +13,21 @@
 #include <vector>
 
 #include "core/app.hpp"
+#include "core/render.hpp"
+#include "core/report.hpp"
+#include "core/scene.hpp"
+#include "core/window.hpp"
 
 namespace boxes {
 
 // What runStep made from the command line. Every hook of the step gets it.
 struct StepRun {
     CommonOptions options;    // the flags every step has (core/app.hpp)
+    bool measure = false;     // --measure: the step's measurements after the image
     Scene scene;              // the scene, with the step's geometry
     RenderSettings settings;  // --width --height --threads --seed
     Camera camera;            // the view: the scene's headless, the orbiting one in the window
-    // Headless: the PNG written, and (for the default image) its pixels and ray counts.
+    // Headless: the PNG written, its pixels, and (when ray traced) its ray counts.
     std::string png;
     Image image;
     RayCounts counts;
@@ -37,6 +43,7 @@ struct StepProgram {
     std::string description;   // the first line of --help
     std::string title;         // the window's title
     std::string defaultScene;  // --scene when the flag is not given
+    std::string measures = "the step's measurements";  // what --measure adds, for --help
 
     // ---- The command line and the scene ------------------------------------------------
     // The step's own flags, added after the common ones (default: none).
@@ -50,13 +57,15 @@ struct StepProgram {
     // mesh.
     std::function<void(StepRun&)> addGeometry;
 
-    // ---- Headless (--headless): one image and its report --------------------------------
-    // The default image's caption in the report.
+    // ---- Headless (--headless): the image, then the report -----------------------------
+    // The image's caption in the report (default: the scene's name).
     std::function<std::string(const StepRun&)> caption;
-    // Writes run.png and records it in the report (default: the scene ray traced from its
-    // camera, renderHeadlessImage, with the caption; fills run.image and run.counts).
-    std::function<void(StepRun&, Report&)> headlessImage;
-    // After the image: the step's measurements, tables, facts and other files.
+    // The step's own image of run.camera's view (default: the scene ray traced from its
+    // camera, timed and its rays counted in the report as render_ms and rays).
+    std::function<Image(StepRun&)> draw;
+    // After the PNG, in every headless run: the step's facts and other files.
+    std::function<void(StepRun&, Report&)> afterImage;
+    // With --measure only: the step's measurements, tables and their files.
     std::function<void(StepRun&, Report&)> measure;
 
     // ---- The window: the step's view, the camera orbiting (core/orbit.hpp) --------------
@@ -76,9 +85,12 @@ struct StepProgram {
     std::function<void(StepRun&)> panel;
 };
 
-// Runs the step program: parses the command line (the common flags, then the step's), makes
-// the scene and the step's geometry, then renders the headless image and writes the report,
-// or opens the window. Returns the exit code (runMain's, core/app.hpp).
+// Runs the step program: parses the command line (the common flags, --measure, then the
+// step's), makes the scene and the step's geometry, then writes the headless image and the
+// report, or opens the window. Returns the exit code (runMain's, core/app.hpp).
 int runStep(int argc, char** argv, const StepProgram& program);
+
+// The window half of runStep (core/step_window.cpp): the step's view of an orbiting camera.
+int runStepWindow(const StepProgram& program, StepRun& run);
 
 }  // namespace boxes

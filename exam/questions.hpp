@@ -54,8 +54,8 @@ struct OpCost {
 };
 
 // What one run of step 05's lab measured that the kind "cost-order" asks about: the cost of
-// each operation of the lecture's list (table op_cost), and the nearest entry of a 3600-entry
-// sine table against std::sin in float (table sincos).
+// each operation of the lecture's list (table op_cost, medians), and the nearest entry of a
+// 3600-entry sine table against std::sin in float (table sincos, the fastest samples).
 struct MeasuredCosts {
     std::string source;  // where the figures come from, as the question names it
     std::vector<OpCost> ops;

@@ -33,7 +33,7 @@ for t in "${targets[@]}"; do
   if [[ $t == results ]]; then
     # Hypothesis in Debian's Python (the grader's interpreter); an input that crashes the
     # interpreter itself is left in $artifacts/current and kept as crash-SHA1.
-    (ulimit -v 4194304 && exec nice -n 19 /usr/bin/python3 fuzz/fuzz_results.py "$seconds" \
+    (ulimit -v 4194304 && exec nice -n 19 /usr/bin/python3 -m fuzz.fuzz_results "$seconds" \
       --artifacts "$artifacts") >"build/fuzz/$t.log" 2>&1 || status=$?
     if [[ -f $artifacts/current ]]; then
       mv "$artifacts/current" "$artifacts/crash-$(sha1sum "$artifacts/current" | cut -c1-40)"

@@ -1,8 +1,8 @@
 #!/usr/bin/python3
 """Fuzzes the grader's reading of test results (Python, so not libFuzzer: Hypothesis).
 
-usage: fuzz/fuzz_results.py SECONDS [--artifacts DIR]   fuzz for SECONDS (fuzz/fuzz.sh)
-       fuzz/fuzz_results.py --replay PATH...             every corpus file once (ctest)
+usage: python3 -m fuzz.fuzz_results SECONDS [--artifacts DIR]   fuzz for SECONDS (fuzz/fuzz.sh)
+       python3 -m fuzz.fuzz_results --replay PATH...             every corpus file once (ctest)
 
 The functions: tools/grading/exercises.py case_results (doctest's XML results, from a file as
 the grader and the tour's report read them, and from a string), and tools/grading/build_and_run.py
@@ -29,18 +29,16 @@ import sys
 import tempfile
 import time
 
-HERE = os.path.dirname(os.path.abspath(__file__))
-ROOT = os.path.dirname(HERE)
-sys.path.insert(0, ROOT)  # the tools package, imported from the repository root
-from tools.grading import exercises  # noqa: E402
+from tools import ROOT
+from tools.grading import exercises
 
 try:
-    from tools.grading import box, build_and_run, sandbox  # noqa: E402
+    from tools.grading import box, build_and_run, sandbox
 except Exception as e:  # a starter kit has no grader: fuzz what exists
     build_and_run = None
     print(f"fuzz_results: tools/grading/build_and_run.py not imported ({e}); list_cases not fuzzed", file=sys.stderr)
 
-CORPUS = os.path.join(HERE, "corpus", "results")
+CORPUS = os.path.join(ROOT, "fuzz", "corpus", "results")
 TIME_LIMIT = 30.0  # seconds per input: longer is a hang, as in fuzz/fuzz.sh
 
 

@@ -21,10 +21,10 @@ def main():
     meshes = "bunny,oa_thor" if os.path.exists(THOR) else "bunny"
     with tempfile.TemporaryDirectory(prefix="boxes-bench06-") as work:
         out = os.path.join(work, "bench06.json")
-        r = subprocess.run([sys.executable, os.path.join(ROOT, "tools", "bench", "bench06.py"),
+        r = subprocess.run([sys.executable, "-m", "tools.bench.bench06",
                             "--width", "80", "--height", "60", "--repeat", "2", "--rounds", "2",
                             "--meshes", meshes, "--program", program, "--out", out],
-                           capture_output=True, text=True, timeout=120)
+                           capture_output=True, text=True, timeout=120, cwd=ROOT)
         if r.returncode != 0 and "SDL" in r.stderr:
             print("SKIP: no OpenGL context here (tools/deps.sh bench): " + r.stderr[-300:])
             return 77

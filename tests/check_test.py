@@ -2,7 +2,7 @@
 """The student's loop end to end (ctest label "grading"): `./workbook check` in a fresh
 starter kit, as a student uses it.
 
-usage: tests/check_test.py WORK_DIR [BUILD_DIR]
+usage: python3 -m tests.check_test WORK_DIR [BUILD_DIR]
   BUILD_DIR: this tree's release build, whose step 01 program renders the kit's reference
   pictures (default build/release)
 
@@ -30,14 +30,13 @@ import sys
 import threading
 import time
 
-ROOT = os.path.dirname(os.path.dirname(os.path.abspath(__file__)))
-sys.path.insert(0, ROOT)  # the tools package, imported from the repository root
-from tools import png  # noqa: E402
-from tools.grading.exercises import exercises  # noqa: E402
-from tools.grading.kit import strip_solutions, write_kit  # noqa: E402
-from tools.grading.mutants import git_apply, read_mutant  # noqa: E402
-from tools import pictures  # noqa: E402
-from tools.pictures import HEIGHT, MARK, WIDTH, render_references  # noqa: E402
+from tools import ROOT
+from tools import png
+from tools.grading.exercises import exercises
+from tools.grading.kit import strip_solutions, write_kit
+from tools.grading.mutants import git_apply, read_mutant
+from tools import pictures
+from tools.pictures import HEIGHT, MARK, WIDTH, render_references
 
 EXERCISE = "1.4"
 MISTAKE = os.path.join(ROOT, "tests", "mutants", "1.4-no-uv-sum-rejection.patch")

@@ -1,7 +1,7 @@
 #!/usr/bin/python3
 """End-to-end tests of grading a class and of the platforms (ctest label "grading").
 
-usage: tests/class_grading_test.py SCENARIO WORK_DIR
+usage: python3 -m tests.class_grading_test SCENARIO WORK_DIR
   class       a generated class of 6 (the first step with exercises only) graded with 2 jobs,
               stopped after the first results and resumed, scores exactly the expected points;
               a third run keeps every result, and a changed submission alone is graded again
@@ -39,14 +39,15 @@ import time
 import xml.etree.ElementTree as ET
 import zipfile
 
-ROOT = os.path.dirname(os.path.dirname(os.path.abspath(__file__)))
-sys.path.insert(0, ROOT)  # the tools package, imported from the repository root
-from tools.grading.class_bench import check as check_expected, make_class, student_sources  # noqa: E402
-from tools.grading.classroom import CLASSROOM_STEP_TIMEOUT, exercise_command, step_id  # noqa: E402
-from tools.grading.exercises import exercises, step_sources  # noqa: E402
-from tools.grading.grade import solution_files  # noqa: E402
-from tools.grading.kit import CLASSROOM_WORKFLOW, write_kit  # noqa: E402
-from tools.grading.sandbox import isolation_problem  # noqa: E402
+from tools import ROOT
+from tools.grading.class_bench import check as check_expected, make_class, student_sources
+from tools.grading.classroom import CLASSROOM_STEP_TIMEOUT, exercise_command, step_id
+from tools.grading.exercises import exercises, step_sources
+from tools.grading.grade import solution_files
+from tools.grading.kit import CLASSROOM_WORKFLOW, write_kit
+from tools.grading.sandbox import isolation_problem
+from tools.grading.submissions import write_files
+from tools.grading.users import processes_of
 
 SKIPPED = 77  # ctest's SKIP_RETURN_CODE
 
@@ -160,10 +161,7 @@ def scenario_class(work):
 def gradescope_run(work, root, files):
     sub = os.path.join(root, "submission")
     shutil.rmtree(sub, ignore_errors=True)
-    for rel, text in files.items():
-        os.makedirs(os.path.dirname(os.path.join(sub, rel)), exist_ok=True)
-        with open(os.path.join(sub, rel), "w", encoding="utf-8") as f:
-            f.write(text)
+    write_files(sub, files)
     results = os.path.join(root, "results", "results.json")
     if os.path.exists(results):
         os.remove(results)
@@ -294,17 +292,7 @@ def user_processes(name):
         uid = int(subprocess.run(["id", "-u", name], capture_output=True, text=True, check=True).stdout)
     except (subprocess.CalledProcessError, ValueError):
         return []
-    found = []
-    for entry in os.listdir("/proc"):
-        if entry.isdigit():
-            try:
-                with open(f"/proc/{entry}/status") as f:
-                    fields = dict(line.split(":", 1) for line in f if ":" in line)
-                if uid in map(int, fields["Uid"].split()[:2]) and fields["State"].split()[0] not in "ZX":
-                    found.append(int(entry))
-            except (OSError, KeyError, ValueError):
-                pass
-    return found
+    return [pid for pid, _ in processes_of(uid)]
 
 
 def layout_root(work):
@@ -430,10 +418,7 @@ def gradescope_root_run(work, files, label):
     root = layout_root(work)
     sub = os.path.join(root, "submission")
     shutil.rmtree(sub, ignore_errors=True)
-    for rel, text in files.items():
-        os.makedirs(os.path.dirname(os.path.join(sub, rel)), exist_ok=True)
-        with open(os.path.join(sub, rel), "w", encoding="utf-8") as f:
-            f.write(text)
+    write_files(sub, files)
     env = root_env(work, root)
     started = time.monotonic()
     r = subprocess.run([os.path.join(root, "run_autograder")], cwd=root, env=env, capture_output=True, text=True,
@@ -600,6 +585,8 @@ def scenario_gradescope_fork(work):
     how far it got."""
     if os.geteuid() != 0:
         return SKIPPED
+    # A C++ body as a list of lines, as the read scenario's: other code, the same shape (what
+    # the duplicates tool pairs them for).
     files, hostile = hostile_files(body=[
         "int forked = 0;",
         "for (;;) {",
@@ -639,10 +626,7 @@ def scenario_gradescope_control(work):
     root = layout_root(work)
     tree = os.path.join(work, "control-tree")
     shutil.rmtree(tree, ignore_errors=True)
-    for rel, text in files.items():
-        os.makedirs(os.path.dirname(os.path.join(tree, rel)), exist_ok=True)
-        with open(os.path.join(tree, rel), "w", encoding="utf-8") as f:
-            f.write(text)
+    write_files(tree, files)
     os.chmod(tree, 0o700)
     junit, js = os.path.join(work, "control.xml"), os.path.join(work, "control.json")
     env = root_env(work, root)

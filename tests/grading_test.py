@@ -1,7 +1,7 @@
 #!/usr/bin/python3
 """End-to-end tests of the starter kit and of grading (ctest label "grading").
 
-usage: tests/grading_test.py SCENARIO WORK_DIR
+usage: python3 -m tests.grading_test SCENARIO WORK_DIR
   kit            the kit has no solution line left, a stub per exercise, everything else equal
   reference      the reference tree scores full points
   kit-zero       the starter kit scores zero, each failure naming its exercise
@@ -38,11 +38,10 @@ import tempfile
 import time
 import xml.etree.ElementTree as ET
 
-ROOT = os.path.dirname(os.path.dirname(os.path.abspath(__file__)))
-sys.path.insert(0, ROOT)  # the tools package, imported from the repository root
-from tools.grading.exercises import BEGIN, END, exercises, step_sources  # noqa: E402
-from tools.grading.kit import NOT_IN_KIT, strip_solutions, write_kit  # noqa: E402
-from tools.grading.sandbox import isolation_problem  # noqa: E402
+from tools import ROOT
+from tools.grading.exercises import BEGIN, END, exercises, step_sources
+from tools.grading.kit import NOT_IN_KIT, strip_solutions, write_kit
+from tools.grading.sandbox import isolation_problem
 
 # The grader as ./workbook grade runs it: a module of the tools package, from the root.
 GRADE = [sys.executable, "-m", "tools.grading.grade"]
@@ -405,7 +404,7 @@ HOSTILE = {
     "loop": ("time limit", "time limit", ["--timeout", "4"]),
     "segv": ("crashed", "crashed: SIGSEGV", []),
     "memory": ("memory limit", "memory limit", ["--memory", "320"]),
-    "files": ("failed", "Read-only file system", []),
+    "files": ("failed", "failed: threw: ", []),  # each path refused: see scenario_hostile
     "read": ("failed", "cannot read", []),
     "network": ("failed", "connect: ", []),
     "output": ("output limit", "output limit", ["--output", "4"]),
@@ -482,6 +481,12 @@ def scenario_hostile(work, kind):
                   f"{kind}: {p} is not there for the student's code")
     if kind == "files":
         check("wrote /tmp/" in got.get("reason", ""), f"{kind}: the private /tmp was writable (and is gone)")
+        # Every other place refused the write with its error (not there, not the sandbox's
+        # user's, or read-only): none of them was written.
+        for p in hostile_paths(token, work):
+            if not p.startswith("/tmp/"):
+                check(f"{p}: " in got.get("reason", "") and f"wrote {p}" not in got.get("reason", ""),
+                      f"{kind}: writing {p} was refused")
     try:
         connection, _ = listener.accept()
         connection.close()

@@ -2,7 +2,7 @@
 """The computer lab (ctest label "lab"): packages installed once by an administrator, every
 student an ordinary user with a clone of their own.
 
-usage: tests/lab_test.py WORK_DIR   (as root: it creates two users; skipped, 77, otherwise)
+usage: python3 -m tests.lab_test WORK_DIR   (as root: it creates two users; skipped, 77, otherwise)
 
 As root, with a root-owned file already at every fixed /tmp path the workbook once used
 (FIXED_PATHS), it creates two unprivileged users, gives each a fresh clone of this tree in
@@ -28,9 +28,9 @@ import sys
 import threading
 import time
 
-ROOT = os.path.dirname(os.path.dirname(os.path.abspath(__file__)))
-sys.path.insert(0, ROOT)
-from tools.grading.kit import tracked_files  # noqa: E402
+from tools import ROOT
+from tools.grading.kit import tracked_files
+from tools.grading.users import processes_of
 
 SKIPPED = 77
 STEP = "01"
@@ -78,26 +78,12 @@ def user_names(work):
     return [f"boxes-lab{tag}{c}" for c in "ab"]
 
 
-def processes_of(uid):
-    found = []
-    for entry in os.listdir("/proc"):
-        if entry.isdigit():
-            try:
-                with open(f"/proc/{entry}/status") as f:
-                    fields = dict(line.split(":", 1) for line in f if ":" in line)
-                if uid in map(int, fields["Uid"].split()[:2]) and fields["State"].split()[0] not in "ZX":
-                    found.append(int(entry))
-            except (OSError, KeyError, ValueError):
-                pass
-    return found
-
-
 def remove_user(name):
     try:
         uid = pwd.getpwnam(name).pw_uid
     except KeyError:
         return
-    for pid in processes_of(uid):
+    for pid, _ in processes_of(uid):
         try:
             os.kill(pid, signal.SIGKILL)
         except ProcessLookupError:

@@ -22,7 +22,6 @@ TriangleTest parseTest(const std::string& name) {
 
 int main(int argc, char** argv) {
     std::string testName = "watertight";
-    bool measure = false;
     bool flat = false;
     size_t crackRays = 100000;
     TriangleTest test = TriangleTest::Watertight;
@@ -35,11 +34,11 @@ int main(int argc, char** argv) {
         "watertight test, side by side.";
     step.title = "Step 01: triangles";
     step.defaultScene = "bunny";
+    step.measures = "the tests' speed and cracks";
     step.addOptions = [&](CLI::App& app) {
         app.add_option("--test", testName, "the ray/triangle test to render with")
             ->check(CLI::IsMember({"plane", "mt", "watertight"}))
             ->capture_default_str();
-        app.add_flag("--measure", measure, "also measure speed and cracks and print the tables");
         app.add_flag("--flat", flat,
                      "shade with the triangles' own normals, without interpolation (exercise 1.6)");
         app.add_option("--crack-rays", crackRays, "rays per mesh and feature for the crack count")
@@ -57,7 +56,7 @@ int main(int argc, char** argv) {
         return "scene '" + run.scene.name + "' with the " + triangleTestName(test) + " test";
     };
     step.measure = [&](StepRun& run, Report& report) {
-        if (measure && grid) measureTriangleTests(run, *grid, crackRays, report);
+        if (grid) measureTriangleTests(run, *grid, crackRays, report);
     };
 
     // The window: T switches the test, M marks where the tests disagree.

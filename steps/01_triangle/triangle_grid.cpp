@@ -3,6 +3,8 @@
 #include <algorithm>
 #include <cstdint>
 
+#include "core/triangle_hit.hpp"
+
 namespace boxes {
 
 TriangleGrid::TriangleGrid(const Mesh& mesh, int material, TriangleTest test)
@@ -117,9 +119,11 @@ void TriangleGrid::walk(const Ray& ray, Visit&& visit) const {
     }
 }
 
-uint32_t TriangleGrid::nearestTriangle(const Ray& rayIn, TriangleTest test, float* tOut) const {
+uint32_t TriangleGrid::nearestTriangle(const Ray& rayIn, TriangleTest test, float* tOut,
+                                       float* uOut, float* vOut) const {
     Ray ray = rayIn;
     uint32_t best = kNoPrimitive;
+    float u = 0.0f, v = 0.0f;
     uint64_t tested = 0;
     walk(ray, [&](size_t cell, float tExit) {
         for (uint32_t k = cellStart_[cell]; k < cellStart_[cell + 1]; ++k) {
@@ -130,6 +134,8 @@ uint32_t TriangleGrid::nearestTriangle(const Ray& rayIn, TriangleTest test, floa
             if (h && (h->t < ray.tmax || (h->t == ray.tmax && tri < best))) {
                 ray.tmax = h->t;
                 best = tri;
+                u = h->u;
+                v = h->v;
             }
         }
         // A hit inside this cell cannot be beaten by a later cell.
@@ -137,29 +143,21 @@ uint32_t TriangleGrid::nearestTriangle(const Ray& rayIn, TriangleTest test, floa
     });
     tested_.fetch_add(tested, std::memory_order_relaxed);
     if (tOut) *tOut = ray.tmax;
+    if (uOut) *uOut = u;
+    if (vOut) *vOut = v;
     return best;
 }
 
 bool TriangleGrid::intersect(const Ray& ray, SurfaceHit& hit) const {
-    float t = 0.0f;
-    uint32_t tri = nearestTriangle(ray, test_, &t);
+    float t = 0.0f, u = 0.0f, v = 0.0f;
+    uint32_t tri = nearestTriangle(ray, test_, &t, &u, &v);
     if (tri == kNoPrimitive) return false;
-    auto h = intersectTriangle(test_, ray, triangle(tri));
+    hit = triangleHit(mesh_, tri, ray, t, u, v, material_);
+    // The shading normal: exercise 1.6's interpolation (smooth), or the triangle's own.
     const auto& idx = mesh_.triangles[tri];
-    hit.t = t;
-    hit.point = ray.at(t);
-    Triangle tr = triangle(tri);
-    Vec3 n = glm::cross(tr.b - tr.a, tr.c - tr.a);
-    float len = glm::length(n);
-    hit.geometricNormal = len > 0.0f ? n / len : Vec3(0, 1, 0);
-    hit.u = h ? h->u : 0.0f;
-    hit.v = h ? h->v : 0.0f;
     hit.shadingNormal = smooth_ ? interpolateNormal(mesh_.normals[idx[0]], mesh_.normals[idx[1]],
-                                                    mesh_.normals[idx[2]], hit.u, hit.v)
+                                                    mesh_.normals[idx[2]], u, v)
                                 : hit.geometricNormal;
-    hit.material = material_;
-    hit.primitive = tri;
-    hit.kind = SurfaceHit::Kind::Triangle;
     return true;
 }
 

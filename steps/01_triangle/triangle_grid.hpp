@@ -28,8 +28,10 @@ public:
     Vec3 boundsMax() const override { return hi_; }
     std::vector<int> materialsUsed() const override { return {material_}; }
 
-    // The nearest triangle along the ray with a given test (kNoPrimitive on a miss).
-    uint32_t nearestTriangle(const Ray& ray, TriangleTest test, float* t = nullptr) const;
+    // The nearest triangle along the ray with a given test (kNoPrimitive on a miss), its t
+    // and barycentrics (u, v) when asked.
+    uint32_t nearestTriangle(const Ray& ray, TriangleTest test, float* t = nullptr,
+                             float* u = nullptr, float* v = nullptr) const;
     uint64_t trianglesTested() const { return tested_.load(std::memory_order_relaxed); }
     Triangle triangle(uint32_t i) const;
     const Mesh& mesh() const { return mesh_; }

@@ -12,7 +12,6 @@ using namespace boxes;
 
 int main(int argc, char** argv) {
     std::string methodName = "slabs";
-    bool measure = false;
     size_t raysPerBox = 1000;
     BoxMethod method = BoxMethod::Slabs;
     std::vector<SceneBox> boxList;
@@ -24,6 +23,7 @@ int main(int argc, char** argv) {
         "Step 02: boxes as six planes (the lecture's way) and the slab method, side by side.";
     step.title = "Step 02: boxes";
     step.defaultScene = "boxes";
+    step.measures = "both methods";
     step.addOptions = [&](CLI::App& app) {
         app.get_option("--scene")->description(
             "'boxes' (this step's scene), or a core scene / OBJ file drawn as boxes (each sphere "
@@ -31,7 +31,6 @@ int main(int argc, char** argv) {
         app.add_option("--method", methodName, "the ray/box test to render with")
             ->check(CLI::IsMember({"planes", "slabs"}))
             ->capture_default_str();
-        app.add_flag("--measure", measure, "also measure both methods and print the tables");
         app.add_option("--rays-per-box", raysPerBox, "measurement rays per random box (64 boxes)")
             ->check(CLI::Range(size_t(10), size_t(100000)));
     };
@@ -57,7 +56,7 @@ int main(int argc, char** argv) {
                " boxes) with the " + boxMethodName(method) + " method";
     };
     step.measure = [&](StepRun& run, Report& report) {
-        if (measure) measureBoxTests(run, *set, raysPerBox, report);
+        measureBoxTests(run, *set, raysPerBox, report);
     };
 
     // The window: M switches the method, D marks where the two disagree.

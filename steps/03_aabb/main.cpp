@@ -5,7 +5,6 @@
 #include <imgui.h>
 
 #include "03_aabb/measure.hpp"
-#include "core/render.hpp"
 #include "core/step.hpp"
 
 using namespace boxes;
@@ -13,7 +12,7 @@ using namespace boxes;
 int main(int argc, char** argv) {
     size_t sphereCount = 3000, triangleCount = 4000, hardRays = 5000;
     std::string pretestName = "on";
-    bool measure = false, pretest = true;
+    bool pretest = true;
     int measureWidth = 64, measureHeight = 48;
     ManyObjects objects;  // the scene's objects, each with its boxes, and their test counts
 
@@ -24,6 +23,7 @@ int main(int argc, char** argv) {
         "rendered with and without a box pre-test.";
     step.title = "Step 03: bounding boxes";
     step.defaultScene = "many";
+    step.measures = "the slab tests on hard rays and the pre-test";
     step.addOptions = [&](CLI::App& app) {
         app.get_option("--scene")->description(
             "'many' (this step's scene: spheres, triangles and the bunny), or a core scene / OBJ "
@@ -35,8 +35,6 @@ int main(int argc, char** argv) {
         app.add_option("--pretest", pretestName, "the bounding-box pre-test in the headless image")
             ->check(CLI::IsMember({"on", "off"}))
             ->capture_default_str();
-        app.add_flag("--measure", measure,
-                     "also measure (slab tests on hard rays, the pre-test) and print the tables");
         app.add_option("--measure-width", measureWidth,
                        "image width of the with/without pre-test frames")
             ->check(CLI::Range(1, 4096));
@@ -64,43 +62,31 @@ int main(int argc, char** argv) {
     step.caption = [&](const StepRun& run) {
         return "scene '" + run.scene.name + "', box pre-test " + pretestName;
     };
-    step.measure = [&](StepRun& run, Report& report) {
+    step.afterImage = [&](StepRun& run, Report& report) {
         report.facts["primitive_tests_per_ray"] = double(objects.counts->primitiveTests.load()) /
                                                   double(std::max<uint64_t>(1, run.counts.total()));
-        if (measure)
-            measureBoundingBoxes(run, objects, hardRays, measureWidth, measureHeight, report);
+    };
+    step.measure = [&](StepRun& run, Report& report) {
+        measureBoundingBoxes(run, objects, hardRays, measureWidth, measureHeight, report);
     };
 
-    // The window. Without the pre-test every ray tests every primitive: the window then
-    // renders at a quarter of the size so a frame takes seconds rather than minutes.
-    double testsPerRay = 0.0, boxesPerRay = 0.0;
-    int shownWidth = 0, shownHeight = 0;
+    // The window: the view with or without the pre-test, and its tests per ray.
+    ManyObjects::View shown;
     step.keys = {{SDLK_b, "bounding-box pre-test on / off (off: quarter resolution)"}};
     step.onKey = [&](StepRun&, int key) {
         if (key == SDLK_b) pretest = !pretest;
         return key == SDLK_b;
     };
     step.render = [&](StepRun& run) {
-        objects.setPretest(pretest);
-        objects.counts->reset();
-        RenderSettings s = run.settings;
-        if (!pretest) {
-            s.width = std::max(1, s.width / 4);
-            s.height = std::max(1, s.height / 4);
-            s.progressLabel = "03_aabb: without the pre-test";
-        }
-        RayCounts counts;
-        Image image = renderImage(run.scene, run.camera, s, &counts);
-        double n = double(std::max<uint64_t>(1, counts.total()));
-        testsPerRay = double(objects.counts->primitiveTests.load()) / n;
-        boxesPerRay = double(objects.counts->boxTests.load()) / n;
-        shownWidth = image.width(), shownHeight = image.height();
-        return image;
+        shown = objects.render(run.camera, run.settings, pretest);
+        return shown.image;
     };
     step.panel = [&](StepRun& run) {
         ImGui::Text("pre-test: %s", pretest ? "on" : "off (quarter resolution)");
-        ImGui::Text("render: %.1f ms (%dx%d)", run.renderMs, shownWidth, shownHeight);
-        ImGui::Text("primitive tests/ray: %.1f, box tests/ray: %.1f", testsPerRay, boxesPerRay);
+        ImGui::Text("render: %.1f ms (%dx%d)", run.renderMs, shown.image.width(),
+                    shown.image.height());
+        ImGui::Text("primitive tests/ray: %.1f, box tests/ray: %.1f", shown.primitiveTestsPerRay,
+                    shown.boxTestsPerRay);
     };
     return runStep(argc, argv, step);
 }

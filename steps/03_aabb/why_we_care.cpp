@@ -188,6 +188,23 @@ void ManyObjects::setPretest(bool on) {
     for (auto& m : meshes) m->setPretest(on);
 }
 
+ManyObjects::View ManyObjects::render(const Camera& camera, RenderSettings settings, bool pretest) {
+    setPretest(pretest);
+    counts->reset();
+    if (!pretest) {
+        settings.width = std::max(1, settings.width / 4);
+        settings.height = std::max(1, settings.height / 4);
+        settings.progressLabel = "03_aabb: without the pre-test";
+    }
+    RayCounts rays;
+    View view;
+    view.image = renderImage(scene, camera, settings, &rays);
+    double n = double(std::max<uint64_t>(1, rays.total()));
+    view.primitiveTestsPerRay = double(counts->primitiveTests.load()) / n;
+    view.boxTestsPerRay = double(counts->boxTests.load()) / n;
+    return view;
+}
+
 ManyObjects makeManyObjects(const std::string& dataDir, float aspect, size_t sphereCount,
                             size_t triangleCount, bool bunny, uint64_t seed) {
     ManyObjects m;

@@ -8,6 +8,7 @@
 #include <vector>
 
 #include "03_aabb/aabb.hpp"
+#include "core/render.hpp"
 #include "core/scene.hpp"
 
 namespace boxes {
@@ -81,6 +82,14 @@ struct ManyObjects {
     std::shared_ptr<SphereCloud> spheres;
     std::vector<std::shared_ptr<TriangleGroups>> meshes;
     void setPretest(bool on);
+
+    // The window's view, with the pre-test on or off (off: at a quarter of the size, so a
+    // frame takes seconds rather than minutes), and the tests it made per ray.
+    struct View {
+        Image image;
+        double primitiveTestsPerRay = 0.0, boxTestsPerRay = 0.0;
+    };
+    View render(const Camera& camera, RenderSettings settings, bool pretest);
 };
 ManyObjects makeManyObjects(const std::string& dataDir, float aspect, size_t spheres = 3000,
                             size_t triangles = 4000, bool bunny = true, uint64_t seed = 1);

@@ -5,7 +5,7 @@
 #include <algorithm>
 #include <cstdio>
 
-#include "core/app.hpp"
+#include "core/image.hpp"
 
 namespace boxes {
 

@@ -7,33 +7,20 @@
 #include <algorithm>
 #include <memory>
 
-#include "04_bvh/advanced/build.hpp"
 #include "04_bvh/advanced/commands.hpp"
 #include "04_bvh/culling_map.hpp"
 #include "04_bvh/measure.hpp"
-#include "core/render.hpp"
+#include "04_bvh/trace.hpp"
 #include "core/step.hpp"
 
 using namespace boxes;
-
-// The scene's mesh through a hierarchy of `options.builder` (the engine builds every one).
-static std::shared_ptr<MeshBvhGeometry> meshGeometry(Scene& scene, const BvhBuildOptions& options) {
-    scene.geometries.clear();
-    if (!scene.hasMesh()) return nullptr;
-    BvhBuildStats stats;
-    Bvh bvh = buildEngineBvh(scene.mesh, options, &stats);
-    auto geometry =
-        std::make_shared<MeshBvhGeometry>(scene.mesh, scene.meshMaterial, std::move(bvh), stats);
-    scene.geometries.push_back(geometry);
-    return geometry;
-}
 
 int main(int argc, char** argv) {
     std::string builderName = "sah";
     MeasureSettings measure;
     std::unique_ptr<EngineCommands> commands;  // trace and check, on the same command line
     BvhBuildOptions build;
-    std::shared_ptr<MeshBvhGeometry> geometry;  // none for a scene without a mesh
+    std::shared_ptr<MeshBvhGeometry> geometry;  // the scene's mesh; none for a scene without one
 
     StepProgram step;
     step.name = "04_bvh";
@@ -42,9 +29,10 @@ int main(int argc, char** argv) {
         "trace command for ray files.";
     step.title = "Step 04: bounding volume hierarchies";
     step.defaultScene = "bunny";
+    step.measures = "builders, traversal, cracks and culling";
     step.addOptions = [&](CLI::App& app) {
-        app.add_option("--builder", builderName,
-                       "hierarchy builder: midpoint, median, sah, sweep-sah, sbvh")
+        app.add_option("--builder", builderName, "hierarchy builder (exercises 4.1-4.3)")
+            ->check(CLI::IsMember({"midpoint", "median", "sah"}))
             ->capture_default_str();
         app.add_option("--bins", measure.bins, "binned SAH: bins per axis")
             ->check(CLI::Range(2, 256))
@@ -53,35 +41,35 @@ int main(int argc, char** argv) {
         commands = std::make_unique<EngineCommands>(app);
     };
     step.command = [&] { return commands->run(); };
+    // The mesh through a hierarchy of the chapter's builders (trace.hpp).
     step.addGeometry = [&](StepRun& run) {
         build.builder = parseBvhBuilder(builderName);
         build.bins = measure.bins;
-        geometry = meshGeometry(run.scene, build);
+        geometry = addMeshBvh(run.scene, build);
     };
     step.caption = [&](const StepRun& run) {
         return "scene '" + run.scene.name + "' through the " + bvhBuilderName(build.builder) +
                " hierarchy";
     };
+    step.afterImage = [&](StepRun& run, Report& report) {
+        if (geometry) addTreeReport(report, run.scene, *geometry, run.png, run.options);
+    };
     step.measure = [&](StepRun& run, Report& report) {
-        if (geometry) addTreeReport(report, run.scene, *geometry, run.png, run.options, measure);
+        if (geometry) measureTree(report, run.scene, *geometry, run.options, measure);
     };
 
     // The window: left the view through the hierarchy, right the hierarchy from above.
     CullingMapWindow map;
-    step.keys = {
-        {SDLK_b, "next builder (midpoint / median / binned SAH / spatial splits), rebuilds"}};
+    step.keys = {{SDLK_b, "next builder (midpoint / median / binned SAH), rebuilds"}};
     for (const KeyBinding& k : CullingMapWindow::keys()) step.keys.push_back(k);
     step.openWindow = [&](StepRun& run) {
         run.settings.width = std::max(1, run.options.width / 2);
         run.scene.camera.aspect = float(run.settings.width) / float(run.settings.height);
     };
     step.onKey = [&](StepRun& run, int key) {
-        constexpr BvhBuilder cycle[] = {BvhBuilder::Midpoint, BvhBuilder::Median,
-                                        BvhBuilder::BinnedSah, BvhBuilder::SpatialSah};
         if (key != SDLK_b || !geometry) return map.onKey(key);
-        const BvhBuilder* at = std::find(std::begin(cycle), std::end(cycle), build.builder);
-        build.builder = at == std::end(cycle) || at + 1 == std::end(cycle) ? cycle[0] : at[1];
-        geometry = meshGeometry(run.scene, build);
+        build.builder = BvhBuilder((int(build.builder) + 1) % std::size(kExerciseBuilders));
+        geometry = addMeshBvh(run.scene, build);
         return true;
     };
     step.render = [&](StepRun& run) {

@@ -39,7 +39,6 @@ Table measureTradeoff(const Table& builds, const Table& traceSpeed, const Table&
 // The whole `--measure` run on the scene's mesh and `bvh` (the program's tree), with the
 // crack count on the bunny and sh1 from dataDir, and the trade-off's plot.
 struct MeasureSettings {
-    bool enabled = false;  // --measure
     int bins = 16;
     size_t traceRays = 100000, crackRays = 5000;
     uint64_t seed = 1;
@@ -47,13 +46,15 @@ struct MeasureSettings {
 };
 void addMeasurements(Report& report, const NamedMesh& mesh, const Bvh& bvh,
                      const MeasureSettings& settings);
-// The headless report's part of the tree: its figures (nodes, sah_cost; build_ms without
-// --measure, whose bvh_build table times every builder), the culling map beside `png`, and
-// with settings.enabled the tables (seed and data folder from `options`).
+// The headless report's part of the tree: its figures (build_ms, nodes, sah_cost) and the
+// culling map beside `png`.
 void addTreeReport(Report& report, const Scene& scene, const MeshBvhGeometry& geometry,
-                   const std::string& png, const CommonOptions& options,
-                   const MeasureSettings& settings);
-// --measure, --measure-rays and --crack-rays into `settings`.
+                   const std::string& png, const CommonOptions& options);
+// --measure: addMeasurements on the scene's mesh and the program's tree (seed and data
+// folder from `options`).
+void measureTree(Report& report, const Scene& scene, const MeshBvhGeometry& geometry,
+                 const CommonOptions& options, const MeasureSettings& settings);
+// --measure-rays and --crack-rays into `settings`.
 void addMeasureOptions(CLI::App& app, MeasureSettings& settings);
 
 }  // namespace boxes

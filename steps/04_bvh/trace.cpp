@@ -44,4 +44,12 @@ bool MeshBvhGeometry::occluded(const Ray& ray) const {
     return traceOccluded(bvh_, ray);
 }
 
+std::shared_ptr<MeshBvhGeometry> addMeshBvh(Scene& scene, const BvhBuildOptions& options) {
+    scene.geometries.clear();
+    if (!scene.hasMesh()) return nullptr;
+    auto geometry = std::make_shared<MeshBvhGeometry>(scene.mesh, scene.meshMaterial, options);
+    scene.geometries.push_back(geometry);
+    return geometry;
+}
+
 }  // namespace boxes

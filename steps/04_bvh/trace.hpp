@@ -4,6 +4,7 @@
 #pragma once
 
 #include <cstdint>
+#include <memory>
 
 #include "04_bvh/bvh.hpp"
 #include "04_bvh/leaf_test.hpp"
@@ -112,5 +113,9 @@ private:
     BvhBuildStats stats_;  // before bvh_: the build fills it
     Bvh bvh_;
 };
+
+// The scene's mesh as its one geometry, through a hierarchy of an exercise builder
+// (options.builder); none for a scene without a mesh.
+std::shared_ptr<MeshBvhGeometry> addMeshBvh(Scene& scene, const BvhBuildOptions& options);
 
 }  // namespace boxes

@@ -11,7 +11,7 @@
 using namespace boxes;
 
 int main(int argc, char** argv) {
-    bool measure = false, noPreviews = false, quick = false;
+    bool noPreviews = false, quick = false;
     int repeats = 5;
     ViewerOptions view;
     std::shared_ptr<LabBvhMesh> mesh;  // the scene's mesh, if any
@@ -24,8 +24,8 @@ int main(int argc, char** argv) {
         "demand, and perceived performance (previews, refinement, photograph mode).";
     step.title = "Step 05: efficiency";
     step.defaultScene = "spheres";
+    step.measures = "the lab";
     step.addOptions = [&](CLI::App& app) {
-        app.add_flag("--measure", measure, "also run the lab and print its tables");
         app.add_option("--repeats", repeats, "timed repeats per variant in the lab")
             ->check(CLI::Range(1, 101))
             ->capture_default_str();
@@ -52,9 +52,10 @@ int main(int argc, char** argv) {
     step.caption = [&](const StepRun& run) {
         return "scene '" + run.scene.name + "', full render";
     };
-    step.measure = [&](StepRun& run, Report& report) {
+    step.afterImage = [&](StepRun& run, Report& report) {
         if (!noPreviews) writePreviews(run, view.budgetMs, report);
-        if (!measure) return;
+    };
+    step.measure = [&](StepRun& run, Report& report) {
         LabOptions lab;
         lab.repeats = repeats;
         lab.threads = run.options.threads;

@@ -9,6 +9,10 @@ RasterView::RasterView(const Scene& scene) : scene(RasterScene::fromScene(scene)
     if (scene.hasMesh()) culler = std::make_unique<FrustumCuller>(scene.mesh);
 }
 
+namespace {
+
+// --near and --far, when given, into the settings: near > 0, far > near (and > 0), else
+// InputError naming the flag.
 void setClipPlanes(RasterSettings& settings, std::optional<double> near,
                    std::optional<double> far) {
     if (near) {
@@ -22,6 +26,50 @@ void setClipPlanes(RasterSettings& settings, std::optional<double> near,
             throw UsageError("--far must be greater than --near (and than 0)");
         settings.far = *far;
     }
+}
+
+}  // namespace
+
+void ViewFlags::add(CLI::App& app) {
+    nearOption = app.add_option("--near", near,
+                                "near plane distance along the view (default: from the scene)");
+    farOption =
+        app.add_option("--far", far, "far plane distance along the view (default: from the scene)");
+    app.add_option("--shadows", shadows, "shadows: none, map (shadow map) or rays (hybrid)")
+        ->check(CLI::IsMember({"none", "map", "rays"}))
+        ->capture_default_str();
+    app.add_option("--bias", shading.mapBias,
+                   "shadow map depth bias in world units (0: 2e-3 of the scene's diagonal)")
+        ->check(CLI::Range(0.0, 1e30));
+    app.add_option("--map-size", shading.mapSize, "shadow map size in texels")
+        ->check(CLI::Range(16, 8192));
+    app.add_flag("--backface", raster.backfaceCulling, "cull back faces");
+    app.add_flag("--no-cull", noCull,
+                 "draw every triangle (no frustum culling with step 04's hierarchy)");
+    app.add_flag("--affine", affine,
+                 "interpolate affinely in screen space (warps) instead of with 1/w");
+    app.add_flag("--checker", shading.checker,
+                 "modulate the surfaces with a checker (shows interpolation)");
+}
+
+RasterView ViewFlags::view(const Scene& scene, int width, int height,
+                           const TexturedFloor* floor) const {
+    RasterView v(scene);
+    if (floor) attachTexcoords(v.scene, floor->frame);
+    v.raster = raster;
+    setClipPlanes(v.raster, nearOption->count() ? std::optional(near) : std::nullopt,
+                  farOption->count() ? std::optional(far) : std::nullopt);
+    v.raster.width = width;
+    v.raster.height = height;
+    v.raster.perspectiveCorrect = !affine;
+    nearFarFor(v.scene, scene.camera, v.raster);  // checks --near and --far
+    v.shading = shading;
+    v.shading.shadows = shadows == "none"  ? ShadowMode::None
+                        : shadows == "map" ? ShadowMode::Map
+                                           : ShadowMode::Rays;
+    v.shading.texture = v.shading.texture || floor;
+    v.culling = !noCull;
+    return v;
 }
 
 RasterFrame drawFrame(const Scene& scene, const RasterView& view, const Camera& camera) {
@@ -44,8 +92,7 @@ void writeFrameBuffers(const RasterView& view, const RasterFrame& frame, const s
     }
 }
 
-void reportFrame(const RasterView& view, const RasterFrame& frame, const std::string& png,
-                 Report& report) {
+void reportFrame(const RasterView& view, const RasterFrame& frame, Report& report) {
     const FrameStats& stats = frame.stats;
     const CullStats& cull = frame.cull;
     report.facts["triangles"] = view.scene.triangles.size();
@@ -67,11 +114,10 @@ void reportFrame(const RasterView& view, const RasterFrame& frame, const std::st
     report.facts["raster_ms"] = stats.milliseconds;
     report.facts["shade_ms"] = frame.shaded.milliseconds;
     report.facts["frame_ms"] = stats.milliseconds + frame.shaded.milliseconds;
-    std::cerr << "06_raster: wrote " << png << " (" << view.raster.width << "x"
-              << view.raster.height << ", " << stats.trianglesDrawn << " of "
-              << view.scene.triangles.size() << " triangles drawn, " << stats.pixelsCovered
-              << " pixels covered, raster " << formatSeconds(stats.milliseconds * 1e-3)
-              << ", shading " << formatSeconds(frame.shaded.milliseconds * 1e-3) << ")\n";
+    std::cerr << "06_raster: " << stats.trianglesDrawn << " of " << view.scene.triangles.size()
+              << " triangles drawn, " << stats.pixelsCovered << " pixels covered, raster "
+              << formatSeconds(stats.milliseconds * 1e-3) << ", shading "
+              << formatSeconds(frame.shaded.milliseconds * 1e-3) << "\n";
 }
 
 }  // namespace boxes

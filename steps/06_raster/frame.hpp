@@ -3,12 +3,14 @@
 // shaded), and the frame's figures for the report.
 #pragma once
 
+#include <CLI/CLI.hpp>
 #include <memory>
 #include <optional>
 #include <string>
 
 #include "06_raster/culling.hpp"
 #include "06_raster/pipeline.hpp"
+#include "06_raster/texture.hpp"
 #include "core/report.hpp"
 
 namespace boxes {
@@ -32,9 +34,23 @@ struct RasterFrame {
     ShadedFrame shaded;
 };
 
-// --near and --far, when given, into the settings: near > 0, far > near (and > 0), else
-// InputError naming the flag.
-void setClipPlanes(RasterSettings& settings, std::optional<double> near, std::optional<double> far);
+// The program's flags that set up the view: --near --far --shadows --bias --map-size
+// --backface --no-cull --affine --checker.
+struct ViewFlags {
+    CLI::Option *nearOption = nullptr, *farOption = nullptr;
+    double near = 0.0, far = 0.0;
+    std::string shadows = "rays";
+    bool affine = false, noCull = false;
+    RasterSettings raster;
+    ShadeSettings shading;
+
+    void add(CLI::App& app);
+    // The view of `scene` (width x height) they ask for, with the floor's texture
+    // coordinates when there is one. A bad --near or --far is an InputError here, before
+    // anything is written.
+    RasterView view(const Scene& scene, int width, int height,
+                    const TexturedFloor* floor = nullptr) const;
+};
 
 // Culls (when view.culling), rasterizes and shades the camera's view of the scene.
 RasterFrame drawFrame(const Scene& scene, const RasterView& view, const Camera& camera);
@@ -44,8 +60,7 @@ void writeFrameBuffers(const RasterView& view, const RasterFrame& frame, const s
                        const std::string& depthPath);
 
 // The frame's counts and times as report facts, and one line on stderr saying what was
-// drawn into `png`.
-void reportFrame(const RasterView& view, const RasterFrame& frame, const std::string& png,
-                 Report& report);
+// drawn.
+void reportFrame(const RasterView& view, const RasterFrame& frame, Report& report);
 
 }  // namespace boxes

@@ -5,7 +5,6 @@ import atexit
 import shutil
 import tempfile
 
-import scratch  # noqa: F401  (tempfile's folders go into one removed at exit)
 
 FOLDER = tempfile.mkdtemp(prefix="boxes-tools-test-")
 tempfile.tempdir = FOLDER

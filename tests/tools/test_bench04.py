@@ -2,13 +2,11 @@
 that cannot be had, the rounds' ratios and the agreement of hits."""
 import os
 import struct
-import sys
 import tempfile
 import unittest
-import scratch  # noqa: F401  (tempfile's folders: one, removed at exit)
+from tests.tools import scratch  # noqa: F401  (tempfile's folders: one, removed at exit)
 
-sys.path.insert(0, os.path.dirname(os.path.dirname(os.path.dirname(os.path.abspath(__file__)))))
-from tools.bench import bench04, meshes, q3map  # noqa: E402
+from tools.bench import bench04, meshes, q3map
 
 
 def tiny_map():

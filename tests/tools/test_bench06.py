@@ -1,11 +1,8 @@
 """Unit tests of tools/bench/bench06.py: the verdict line from a row's ratios."""
-import os
-import sys
 import unittest
-import scratch  # noqa: F401  (tempfile's folders: one, removed at exit)
+from tests.tools import scratch  # noqa: F401  (tempfile's folders: one, removed at exit)
 
-sys.path.insert(0, os.path.dirname(os.path.dirname(os.path.dirname(os.path.abspath(__file__)))))
-from tools.bench import bench06  # noqa: E402
+from tools.bench import bench06
 
 
 def row(vis, shaded, cpu_vis=None, cpu_shaded=None, no_culling=0.5):

@@ -4,15 +4,12 @@ build of a two-file project (a few seconds)."""
 import io
 import os
 import shutil
-import sys
 import tempfile
 import unittest
 
-import scratch  # noqa: F401  (tempfile's folders go into one removed at exit)
+from tests.tools import scratch  # noqa: F401  (tempfile's folders go into one removed at exit)
 
-ROOT = os.path.dirname(os.path.dirname(os.path.dirname(os.path.abspath(__file__))))
-sys.path.insert(0, ROOT)
-from tools import build  # noqa: E402
+from tools import build
 
 
 class Commands(unittest.TestCase):

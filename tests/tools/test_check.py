@@ -1,21 +1,18 @@
 """Unit tests of the student's check (tools/check.py), its pictures (tools/pictures.py) and
 the PNG reader (tools/png.py): no build, no test program."""
-import json
 import os
 import re
 import stat
-import sys
 import tempfile
 import time
 import unittest
 from unittest import mock
 
-import scratch  # noqa: F401  (tempfile's folders go into one removed at exit)
+from tests.tools import scratch  # noqa: F401  (tempfile's folders go into one removed at exit)
 
-ROOT = os.path.dirname(os.path.dirname(os.path.dirname(os.path.abspath(__file__))))
-sys.path.insert(0, ROOT)
-from tools import check, label, pictures, png  # noqa: E402
-from tools.grading.exercises import exercises  # noqa: E402
+from tools import ROOT
+from tools import check, label, pictures, png
+from tools.grading.exercises import exercises
 
 
 def xml(*cases):

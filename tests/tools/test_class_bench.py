@@ -2,13 +2,11 @@
 class's grades with the expected points."""
 import json
 import os
-import sys
 import tempfile
 import unittest
-import scratch  # noqa: F401  (tempfile's folders: one, removed at exit)
+from tests.tools import scratch  # noqa: F401  (tempfile's folders: one, removed at exit)
 
-sys.path.insert(0, os.path.dirname(os.path.dirname(os.path.dirname(os.path.abspath(__file__)))))
-from tools.grading import class_bench  # noqa: E402
+from tools.grading import class_bench
 
 SOURCE = """#include <a>
 // EXERCISE 1.1: one (1 point)

@@ -1,11 +1,8 @@
 """Unit tests of tools/grading/classroom.py: the kit's GitHub Classroom workflow."""
-import os
-import sys
 import unittest
 
-sys.path.insert(0, os.path.dirname(os.path.dirname(os.path.dirname(os.path.abspath(__file__)))))
-from tools.grading import classroom  # noqa: E402
-from tools.grading.exercises import Exercise  # noqa: E402
+from tools.grading import classroom
+from tools.grading.exercises import Exercise
 
 
 class Workflow(unittest.TestCase):

@@ -1,13 +1,11 @@
 """Unit tests of tools/grading/exercises.py: the exercise markers and doctest's XML results."""
 import os
-import sys
 import tempfile
 import unittest
-import scratch  # noqa: F401  (tempfile's folders: one, removed at exit)
+from tests.tools import scratch  # noqa: F401  (tempfile's folders: one, removed at exit)
 
-sys.path.insert(0, os.path.dirname(os.path.dirname(os.path.dirname(os.path.abspath(__file__)))))
-from tools.grading import exercises  # noqa: E402
-from tools.grading.exercises import case_results, parameter_names, parse_file, suite_results  # noqa: E402
+from tools.grading import exercises
+from tools.grading.exercises import case_results, parameter_names, parse_file, suite_results
 
 SOURCE = """#include <optional>
 // EXERCISE 1.4: Moller-Trumbore ray/triangle intersection (2 points)

@@ -1,23 +1,26 @@
 """Unit tests of tools/grading/grade.py and its modules (build_and_run, grade_report,
 grading_tree, box): the reasons a case or a build fails, the points table and its files, the
 hidden tests' names, the grading tree's sync, the deadline."""
+import contextlib
+import io
 import json
 import os
-import sys
 import tempfile
 import time
 import unittest
 import xml.etree.ElementTree as ET
-import scratch  # noqa: F401  (tempfile's folders: one, removed at exit)
+from tests.tools import scratch  # noqa: F401  (tempfile's folders: one, removed at exit)
 
-sys.path.insert(0, os.path.dirname(os.path.dirname(os.path.dirname(os.path.abspath(__file__)))))
-from tools.grading import (box, build_and_run, class_bench, errors, grade, grade_class, grade_report,  # noqa: E402
+from tools.grading import (box, build_and_run, class_bench, errors, grade, grade_class, grade_report,
                            gradescope, grading_tree, sandbox)
-sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
-import test_strict_numbers  # noqa: E402
-from tools.grading.exercises import CaseResult, Exercise  # noqa: E402
-from tools.grading.build_and_run import CaseOutcome, case_outcome  # noqa: E402
-from tools.grading.grade_report import exercise_row  # noqa: E402
+from tests.tools import test_strict_numbers
+from tools.grading.exercises import CaseResult, Exercise, exercises
+from tools.grading.build_and_run import CaseOutcome, case_outcome
+from tools.grading.grade_report import exercise_row
+
+
+def first_step():
+    return sorted({f"{e.step:02d}" for e in exercises(grade.ROOT)})[0]
 
 
 def result(status="ok", reason=None, stdout=b"", stderr=b"", seconds=0.25, code=0):
@@ -277,6 +280,47 @@ class GradeInto(unittest.TestCase):
         r = grade.grade_into(tempfile.mkdtemp(), tree, grade.GradeOptions(steps=["99"], no_isolation=True))
         self.assertEqual(r.code, 1)
         self.assertIn("grade: --steps 99: no such step with exercises", r.last_line)
+
+
+class FullDisk(unittest.TestCase):
+    """A full grading disk is the machine's failure: no points, a reason, exit 75."""
+
+    def setUp(self):
+        self.tree = tempfile.mkdtemp()
+        os.makedirs(os.path.join(self.tree, "steps"))
+        os.environ["BOXES_GRADE_MIN_FREE_MB"] = str(1 << 40)  # more than any disk has
+
+    def tearDown(self):
+        del os.environ["BOXES_GRADE_MIN_FREE_MB"]
+
+    def test_the_free_space_it_needs(self):
+        self.assertIn("the grading disk is full", box.disk_trouble(self.tree))
+        os.environ["BOXES_GRADE_MIN_FREE_MB"] = "1"
+        self.assertIsNone(box.disk_trouble(self.tree))
+
+    def test_grading_stops_before_it_starts(self):
+        folder = tempfile.mkdtemp()
+        r = grade.grade_into(folder, self.tree, grade.GradeOptions(no_isolation=True, steps=[first_step()],
+                                                                   work=tempfile.mkdtemp()))
+        self.assertEqual((r.code, r.results), (errors.NOT_GRADED_EXIT, []))
+        self.assertTrue(r.last_line.startswith("not graded: the grading disk is full"), r.last_line)
+        err = io.StringIO()
+        with contextlib.redirect_stderr(err):
+            code = grade.main([self.tree, "--no-isolation", "--steps", first_step(), "--work", tempfile.mkdtemp()])
+        self.assertEqual(code, errors.NOT_GRADED_EXIT)
+        self.assertIn("grade: not graded: the grading disk is full", err.getvalue())
+
+    def test_a_failed_command_on_a_full_disk(self):
+        real = sandbox.run
+        sandbox.run = lambda cmd, limits, **kw: result("failed", "failed: exit 1")
+        try:
+            iso = box.Isolation(False, sandbox.Limits(900), sandbox.Limits(60), disk=self.tree)
+            with self.assertRaisesRegex(errors.NotGraded, "the grading disk is full"):
+                box.sandboxed(["x"], iso.test, iso)
+            os.environ["BOXES_GRADE_MIN_FREE_MB"] = "1"
+            self.assertEqual(box.sandboxed(["x"], iso.test, iso).status, "failed")  # the student's
+        finally:
+            sandbox.run = real
 
 
 class StrictNumbers(test_strict_numbers.FlagChecks, unittest.TestCase):

@@ -1,16 +1,19 @@
-"""Unit tests of tools/grading/grade_class.py: finding the submissions, the class table and
-what makes a cached grade stale."""
+"""Unit tests of tools/grading/grade_class.py: finding the submissions, the class table (its
+names escaped), one bad submission's row and what makes a cached grade stale."""
+import contextlib
 import csv
+import io
 import os
-import sys
 import tempfile
+import types
 import unittest
 import zipfile
-import scratch  # noqa: F401  (tempfile's folders: one, removed at exit)
+from unittest import mock
+from tests.tools import scratch  # noqa: F401  (tempfile's folders: one, removed at exit)
 
-sys.path.insert(0, os.path.dirname(os.path.dirname(os.path.dirname(os.path.abspath(__file__)))))
-from tools.grading import grade_class  # noqa: E402
-from tools.grading.exercises import Exercise  # noqa: E402
+from tools.grading import grade, grade_class
+from tools.grading.errors import NOT_GRADED_EXIT
+from tools.grading.exercises import Exercise
 
 EXERCISES = [Exercise("1.1", "a sum", 1, "x"), Exercise("1.2", "a root", 2, "x")]
 
@@ -46,6 +49,72 @@ class ClassTable(unittest.TestCase):
                                 ["alice", "0", "0", "0", "3", "not graded: no step sources", "0.0"],
                                 ["bob", "0", "2", "2", "3", "ok", "12.3"]])
         self.assertFalse(os.path.exists(path + ".tmp"))
+
+
+class HostileNames(unittest.TestCase):
+    NAMES = ["\x1b]0;owned\x07\x1b[2J", "new\nline", "=HYPERLINK(\"http://x\")", "+1", "-2", "@SUM(A1)",
+             "\u202egnp.exe", "tab\there"]
+
+    def test_a_cell_is_one_escaped_line_and_never_a_formula(self):
+        for name in self.NAMES:
+            got = grade_class.cell(name)
+            self.assertFalse(any(c in got for c in "\x1b\x07\n\t\u202e"), got)
+            self.assertNotIn(got[:1], ("=", "+", "-", "@"), got)
+        self.assertEqual(grade_class.cell("\x1b[31mred"), "\\x1b[31mred")
+        self.assertEqual(grade_class.cell("=1+1"), "'=1+1")
+        self.assertEqual(grade_class.cell("alice"), "alice")
+
+    def test_the_table_and_the_progress_lines_carry_names_escaped(self):
+        results = [{"student": n, "rows": [], "total": 0, "build": f"not graded: {n}"} for n in self.NAMES]
+        path = os.path.join(tempfile.mkdtemp(), "class.csv")
+        grade_class.write_csv(path, results, EXERCISES)
+        with open(path, newline="") as f:
+            text = f.read()
+        self.assertFalse(any(c in text for c in "\x1b\x07\t\u202e"))
+        self.assertEqual(len(text.splitlines()), 1 + len(self.NAMES))  # no name adds a line
+        err = io.StringIO()
+        with contextlib.redirect_stderr(err):
+            grade_class.say("1/1 graded: " + self.NAMES[0] + self.NAMES[1])
+        self.assertEqual(err.getvalue(), "[class] 1/1 graded: \\x1b]0;owned\\x07\\x1b[2Jnew\\nline\n")
+
+
+class OneBadSubmission(unittest.TestCase):
+    """What goes wrong with one submission is its own row; the class goes on."""
+
+    def setUp(self):
+        self.root = tempfile.mkdtemp()
+        self.workers = grade_class.Workers(os.path.join(self.root, "work"), 1)
+        self.opts = types.SimpleNamespace(out=self.root, steps=["01"], hidden=None, timeout=10, compile_jobs=1,
+                                          no_sandbox=True, student_timeout=60)
+
+    def tearDown(self):
+        self.workers.close()
+
+    def grade(self, files):
+        sub = {"student": "s", "entry": "s", "hash": "h", "files": files}
+        with contextlib.redirect_stderr(io.StringIO()):
+            return grade_class.grade_one(sub, self.workers, self.opts)
+
+    def test_staging_that_fails_is_a_not_graded_row(self):
+        # Paths the reader would refuse (submissions.check_paths), given to staging directly.
+        r = self.grade({"steps/01_x/a.cpp": b"1", "steps/01_x/a.cpp/b.cpp": b"2"})
+        self.assertEqual((r["status"], r["total"], r["rows"]), ("error", 0, []))
+        self.assertTrue(r["build"].startswith("not graded: staging failed") and r["build"].endswith(", retry"),
+                        r["build"])
+        self.assertEqual(self.workers.take(), 0)  # the worker's folder was given back
+        self.workers.give(0)
+
+    def test_a_failure_of_the_grader_is_a_not_graded_row(self):
+        with mock.patch.object(grade_class, "run_grader", side_effect=RuntimeError("a bug")):
+            r = self.grade({"steps/01_x/a.cpp": b"1"})
+        self.assertEqual(r["build"], "not graded: the grader failed (RuntimeError: a bug), retry")
+
+    def test_a_full_grading_disk_is_a_not_graded_row(self):
+        report = grade.Report(NOT_GRADED_EXIT, 1.0, [], [], "not graded: the grading disk is full: 3 MB free")
+        with mock.patch.object(grade_class, "run_grader", return_value=report):
+            r = self.grade({"steps/01_x/a.cpp": b"1"})
+        self.assertEqual((r["status"], r["build"]),
+                         ("error", "not graded: the grading disk is full: 3 MB free, retry"))
 
 
 class ConfigHash(unittest.TestCase):

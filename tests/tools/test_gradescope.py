@@ -1,13 +1,11 @@
 """Unit tests of tools/grading/gradescope.py: results.json in Gradescope's format and the
 hidden tests' names."""
 import os
-import sys
 import tempfile
 import unittest
-import scratch  # noqa: F401  (tempfile's folders: one, removed at exit)
+from tests.tools import scratch  # noqa: F401  (tempfile's folders: one, removed at exit)
 
-sys.path.insert(0, os.path.dirname(os.path.dirname(os.path.dirname(os.path.abspath(__file__)))))
-from tools.grading import gradescope  # noqa: E402
+from tools.grading import gradescope
 
 ROWS = [{"exercise": "1.1", "title": "a sum", "max": 1, "points": 1, "passed": True, "status": "passed",
          "reason": "", "details": ["passed: fine", "passed: hidden: one more"]},

@@ -1,13 +1,12 @@
 """Unit tests of tools/grading/kit.py: stripping the solutions from a source."""
 import os
-import sys
 import tempfile
 import unittest
-import scratch  # noqa: F401  (tempfile's folders: one, removed at exit)
+from tests.tools import scratch  # noqa: F401  (tempfile's folders: one, removed at exit)
 
-sys.path.insert(0, os.path.dirname(os.path.dirname(os.path.dirname(os.path.abspath(__file__)))))
-from tools.grading import kit  # noqa: E402
-from tools.grading.kit import check_no_solution_left, strip_solutions  # noqa: E402
+from tools.grading import kit
+from tools.grading.submissions import write_files
+from tools.grading.kit import check_no_solution_left, strip_solutions
 
 SOURCE = """#include "steps/01_x/x.hpp"
 #include <cmath>
@@ -127,10 +126,7 @@ class KitContents(unittest.TestCase):
         files = {"steps/01_x/x.cpp": SOURCE, "tests/mutants/1.1-wrong-sum.patch":
                  "Mistake: a - b\nCaught by: sum\n\n-    float secret = a + b;\n+    float secret = a - b;\n",
                  "tests/hints/mistakes.json": "{}", "tools/grading/mutants.py": "# runner\n"}
-        for rel, text in files.items():
-            os.makedirs(os.path.dirname(os.path.join(root, rel)), exist_ok=True)
-            with open(os.path.join(root, rel), "w") as f:
-                f.write(text)
+        write_files(root, files)
         dest = os.path.join(tempfile.mkdtemp(), "kit")
         kit.write_kit(dest, root)
         written = kit.tracked_files(dest)

@@ -6,14 +6,12 @@ test cases that exist. The slow runs themselves are the ctest label mutants and
 ./workbook mutants --safeguards."""
 import json
 import os
-import subprocess
-import sys
 import tempfile
 import unittest
 
-ROOT = os.path.dirname(os.path.dirname(os.path.dirname(os.path.abspath(__file__))))
-sys.path.insert(0, ROOT)
-from tools.grading import mutants, safeguards  # noqa: E402
+from tools import ROOT
+from tools.grading import mutants, safeguards
+from tools.grading.submissions import write_files
 
 PATCH = """Mistake: a + b written a - b
 Caught by: sum: worked values
@@ -29,14 +27,6 @@ diff --git a/steps/01_x/x.cpp b/steps/01_x/x.cpp
 """
 SOURCE = "float sum(float a, float b) {\n    return a + b;\n}\n"
 TESTS = 'TEST_SUITE("exercise 1.1") {\n    TEST_CASE("sum: worked values") {}\n}\n'
-
-
-def write_files(root, files):
-    """{path relative to root: text} written, folders made."""
-    for rel, text in files.items():
-        os.makedirs(os.path.dirname(os.path.join(root, rel)), exist_ok=True)
-        with open(os.path.join(root, rel), "w") as f:
-            f.write(text)
 
 
 def small_tree(patch=PATCH, hints=None):

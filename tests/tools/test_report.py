@@ -2,17 +2,15 @@
 import json
 import os
 import re
-import sys
 import tempfile
 import unittest
 from unittest import mock
 
-import scratch  # noqa: F401  (tempfile's folders go into one removed at exit)
+from tests.tools import scratch  # noqa: F401  (tempfile's folders go into one removed at exit)
 
-sys.path.insert(0, os.path.dirname(os.path.dirname(os.path.dirname(os.path.abspath(__file__)))))
-from tools import png, report  # noqa: E402
-from tools.plots import pareto_front, plot  # noqa: E402
-from tools.report import table_html  # noqa: E402
+from tools import png, report
+from tools.plots import pareto_front, plot
+from tools.report import table_html
 
 
 class ParetoFront(unittest.TestCase):

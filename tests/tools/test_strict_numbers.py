@@ -5,13 +5,10 @@ gradescope, class_bench: not in the starter kit) are tested the same way in test
 import argparse
 import contextlib
 import io
-import os
-import sys
 import unittest
 
-sys.path.insert(0, os.path.dirname(os.path.dirname(os.path.dirname(os.path.abspath(__file__)))))
-from tools.grading import sandbox  # noqa: E402
-from tools.grading.strict_numbers import decimal, integer, integer_list, step_list  # noqa: E402
+from tools.grading import sandbox
+from tools.grading.strict_numbers import decimal, integer, integer_list, step_list
 
 
 def refusal(main, argv):

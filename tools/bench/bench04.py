@@ -1,7 +1,7 @@
 #!/usr/bin/python3
 """Step 04 beside Intel Embree: the same rays, back to back, one thread each.
 
-usage: tools/bench/bench04.py [--rays N] [--repeat K] [--rounds R]
+usage: python3 -m tools.bench.bench04 [--rays N] [--repeat K] [--rounds R]
                         [--meshes bunny,motorbike,oa_thor] [--kinds primary,diffuse,random]
                         [--builders midpoint,median,sah,sah4,sah8,sbvh,sbvh4,sbvh8]
                         [--no-extras] [--thread-rays N] [--thread-pairs P] [--quiet-wait S]
@@ -42,13 +42,8 @@ import sys
 import tempfile
 import time
 
-try:
-    from tools.bench import machine, meshes  # imported as tools.bench.bench04 (the tests)
-except ImportError:
-    import machine  # run as a script: its folder is on the path
-    import meshes
-
-ROOT = os.path.dirname(os.path.dirname(os.path.dirname(os.path.abspath(__file__))))
+from .. import ROOT
+from . import machine, meshes
 INSIDE = ["--eye", "960,-384,2", "--look", "960,600,2", "--up", "0,0,1", "--fov", "90"]
 
 
@@ -178,7 +173,7 @@ def measure_threads(a, obj, mesh, kind, work, gate):
     return t
 
 
-# The engine's targets, one thread unless named (the advanced README keeps the latest run):
+# The engine's targets, one thread unless named (the advanced README has their table):
 # (what, builders whose best counts, ray kind, the least ratio to Embree on every mesh).
 TARGETS = [("best 8-wide tree, primary rays", ("sah 8-wide", "sbvh 8-wide"), "primary", 1.3),
            ("best 8-wide tree, diffuse rays", ("sah 8-wide", "sbvh 8-wide"), "diffuse", 1.0),
@@ -408,7 +403,7 @@ def bench(a, work):
     for t in threads:
         print("  %-10s %-8s 1: %.3f  2: %.3f  speed-up %.2fx  (Embree %.2fx)" % (
             t["mesh"], t["kind"], t["one"], t["two"], t["speedup"], t["embree_speedup"]))
-    print("\nThe targets (ratios to Embree on every mesh; the README keeps the latest run):")
+    print("\nThe targets (ratios to Embree on every mesh; the advanced README has their table):")
     for line in target_lines(rows, threads):
         print(line)
     for line in unavailable:

@@ -1,7 +1,7 @@
 #!/usr/bin/python3
 """Step 06's rasterizer beside Mesa's llvmpipe: the same triangles, view and size, one thread.
 
-usage: tools/bench/bench06.py [--meshes bunny,oa_thor] [--width 640] [--height 480]
+usage: python3 -m tools.bench.bench06 [--meshes bunny,oa_thor] [--width 640] [--height 480]
                         [--repeat K] [--rounds R] [--out out/06_raster_bench.json]
                         [--program PATH] [--cache DIR] [--data DIR | BOXES_MESHES=DIR]
        (./workbook bench, after step 04's rows; ./workbook bench raster [ARGS...]: only these)
@@ -25,13 +25,8 @@ import statistics
 import subprocess
 import sys
 
-try:
-    from tools.bench import machine, meshes  # imported as tools.bench.bench06 (the tests)
-except ImportError:
-    import machine  # run as a script: its folder is on the path
-    import meshes
-
-ROOT = os.path.dirname(os.path.dirname(os.path.dirname(os.path.abspath(__file__))))
+from .. import ROOT
+from . import machine, meshes
 TARGET = 1.0  # step 06 at least as fast as llvmpipe
 AGREEMENT = 0.995
 

@@ -11,12 +11,9 @@ import subprocess
 import tempfile
 import zipfile
 
-try:
-    from tools.bench import q3map
-except ImportError:
-    import q3map
+from .. import ROOT
+from . import q3map
 
-ROOT = os.path.dirname(os.path.dirname(os.path.dirname(os.path.abspath(__file__))))
 SHIPPED = {"bunny", "sh1"}
 MOTORBIKE_PACKAGE = "openfoam-examples"
 MOTORBIKE_FILE = ("/usr/share/doc/openfoam-examples/examples/resources/geometry/"
@@ -166,7 +163,7 @@ def mesh_path(name, cache, data=None):
 
 
 def main(argv=None):
-    """python3 tools/bench/meshes.py MESH [--cache DIR]: prints the OBJ's path, converting it
+    """python3 -m tools.bench.meshes MESH [--cache DIR]: prints the OBJ's path, converting it
     into the cache first when needed; exit code 3 (and why on stderr) when it cannot be had."""
     import argparse
     import sys

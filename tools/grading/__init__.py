@@ -14,7 +14,4 @@ class_bench  a generated class, its expected points, and the class grader's benc
 
 The grader (grade and its parts, grade_class, gradescope, class_bench) needs the solutions
 and stays out of the starter kit; the kit keeps the rest (the tour's report reads exercises)."""
-import os
-
-# The workbook tree these tools belong to (tools/grading/ is two levels below it).
-ROOT = os.path.dirname(os.path.dirname(os.path.dirname(os.path.abspath(__file__))))
+from .. import ROOT  # noqa: F401  (the workbook tree: tools.ROOT, here for the grading modules)

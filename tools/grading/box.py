@@ -1,8 +1,8 @@
 """How student code runs: isolated (bubblewrap) or not, with the limits of a build and of a
 test case, within the grading's deadline, in a clean environment; without bubblewrap, as
 root, as an unprivileged user that owns the build folder only while it builds and must be
-unable to read the reference and the hidden tests."""
-import contextlib
+unable to read the reference and the hidden tests. A full grading disk is the machine's
+failure (NotGraded), never the student's."""
 import dataclasses
 import json
 import os
@@ -11,8 +11,9 @@ import time
 from dataclasses import dataclass
 
 from . import sandbox
-from .errors import GradeError, OutOfTime
-from .grade_report import say
+from .errors import GradeError, NotGraded, OutOfTime
+from .grade_report import printable, say
+from .users import USER_PYTHON, User
 
 
 @dataclass
@@ -29,37 +30,15 @@ class Isolation:
     deadline: float = None  # time.monotonic() by which the whole grading ends (None: none)
     log: object = None  # where progress goes (None: stderr)
     # Without isolation, as root: the unprivileged user student code runs as (a
-    # sandbox.User). The grading tree is then readable to it, the build folder its own only
-    # while it builds, each test case's folder its own; the rest is the grader's.
-    user: sandbox.User = None
+    # users.User). The grading tree is then readable to it, the build folder its own only
+    # while it builds, each test case's folder its own; the rest is the grader's. (Isolated,
+    # as root, each command runs as a user id of its own: sandbox.run picks it.)
+    user: User = None
+    disk: str = None  # the grading folder, whose disk a failed command may have found full
 
     @property
     def drop(self):
         return self.user is not None and not self.isolate
-
-
-def chown_tree(path, uid, gid):
-    """chown -R without following links."""
-    os.lchown(path, uid, gid)
-    for d, dirs, files in os.walk(path):
-        for n in dirs + files:
-            os.lchown(os.path.join(d, n), uid, gid)
-
-
-@contextlib.contextmanager
-def building(work, iso):
-    """While a configure or a build runs: WORK/build is the student user's (its compilers
-    write there), afterwards the grader's again, so that the tests, which run the student's
-    code as that user, cannot change what later builds and tests use."""
-    build = os.path.join(work, "build")
-    if not iso.drop:
-        yield
-        return
-    chown_tree(build, iso.user.uid, iso.user.gid)
-    try:
-        yield
-    finally:
-        chown_tree(build, os.getuid(), os.getgid())
 
 
 # Run as the student user: which of the paths it can open (a folder: list).
@@ -85,7 +64,7 @@ def check_user_access(iso, work, secret):
     with tempfile.TemporaryDirectory(prefix="probe-", dir=work) as folder:
         os.chmod(folder, 0o711)
         os.chown(folder, iso.user.uid, iso.user.gid)
-        r = sandbox.run([sandbox.USER_PYTHON, "-I", "-S", "-c", _ACCESS_PROBE] + paths,
+        r = sandbox.run([USER_PYTHON, "-I", "-S", "-c", _ACCESS_PROBE] + paths,
                         sandbox.Limits(seconds=30, memory_mb=1024, output_mb=1), writable=[folder],
                         isolate=False, env=clean_env(folder), user=iso.user)
     try:
@@ -115,9 +94,32 @@ def sandboxed(cmd, limits, iso, **kw):
             limits = dataclasses.replace(limits, seconds=left)
     r = sandbox.run(cmd, limits, isolate=iso.isolate, hidden=iso.hidden,
                     user=iso.user if iso.drop else None, **kw)
+    if not r.ok and iso.disk:  # now, before the grader cleans up what filled it
+        trouble = disk_trouble(iso.disk)
+        if trouble:
+            raise NotGraded(trouble)
     if iso.deadline is not None and time.monotonic() >= iso.deadline:
         raise OutOfTime()
     return r
+
+
+MIN_FREE_MB = 512  # what grading one tree may need on the grading disk, at most
+
+
+def disk_trouble(path):
+    """Why the disk of `path` cannot hold a grade (less free than MIN_FREE_MB, or
+    BOXES_GRADE_MIN_FREE_MB), or None. Student code has its own space (sandbox.Limits
+    disk_mb): a full grading disk is the machine's, or another program's, doing."""
+    need = int(os.environ.get("BOXES_GRADE_MIN_FREE_MB") or MIN_FREE_MB) << 20
+    try:
+        info = os.statvfs(path)
+    except OSError:
+        return None
+    free = info.f_bavail * info.f_frsize
+    if free >= need:
+        return None
+    return (f"the grading disk is full: {free >> 20} MB free where grading needs {need >> 20} MB "
+            f"({printable(path)})")
 
 
 def clean_env(home):

@@ -12,7 +12,7 @@ import xml.etree.ElementTree as ET
 from dataclasses import dataclass
 
 from . import ROOT
-from .box import building, clean_env, sandboxed, write_private
+from .box import clean_env, sandboxed, write_private
 from .errors import GradeError
 from .exercises import MAX_RESULT_BYTES, case_results, step_dirs
 from .grade_report import exercise_row, printable, say
@@ -50,15 +50,14 @@ def configure(work, iso):
     os.makedirs(build, exist_ok=True)
     set_hidden_mode(work, 0o644)
     try:
-        with building(work, iso):
-            if not fresh:
-                say("configuring the grading tree (once; later grades reuse it)", iso.log)
-                r = sandboxed(["cmake", "-S", os.path.join(work, "src"), "-B", build, "-G", "Ninja"] +
-                              [f"-D{k}={v}" for k, v in GRADING_CACHE.items()], iso.build, iso,
-                              writable=[build], env=clean_env(build), readable=[os.path.join(work, "src")])
-            else:
-                r = sandboxed(["cmake", "--build", build, "--target", "build.ninja"], iso.build, iso,
-                              writable=[build], env=clean_env(build), readable=[os.path.join(work, "src")])
+        if not fresh:
+            say("configuring the grading tree (once; later grades reuse it)", iso.log)
+            r = sandboxed(["cmake", "-S", os.path.join(work, "src"), "-B", build, "-G", "Ninja"] +
+                          [f"-D{k}={v}" for k, v in GRADING_CACHE.items()], iso.build, iso,
+                          writable=[build], env=clean_env(build), readable=[os.path.join(work, "src")])
+        else:
+            r = sandboxed(["cmake", "--build", build, "--target", "build.ninja"], iso.build, iso,
+                          writable=[build], env=clean_env(build), readable=[os.path.join(work, "src")])
     finally:
         set_hidden_mode(work, 0)
     if not r.ok:
@@ -69,12 +68,12 @@ def configure(work, iso):
 def cmake_build(work, targets, iso):
     """Builds targets (names, or object files by their path in WORK/build) in the sandbox: the
     compilers run on the student's sources, so the build writes only WORK/build, within the
-    build limits."""
+    build limits (as another user than the grader's, WORK/build is that user's only while
+    it builds: sandbox.run lends it, so no test can change what later builds use)."""
     build = os.path.join(work, "build")
-    with building(work, iso):
-        return sandboxed(["cmake", "--build", build, "--target", *targets, "--", f"-j{iso.jobs}"],
-                         iso.build, iso, writable=[build], env=clean_env(build),
-                         readable=[os.path.join(work, "src")])
+    return sandboxed(["cmake", "--build", build, "--target", *targets, "--", f"-j{iso.jobs}"],
+                     iso.build, iso, writable=[build], env=clean_env(build),
+                     readable=[os.path.join(work, "src")])
 
 
 def build_step(work, number, iso):
@@ -153,7 +152,7 @@ def list_cases(binary, iso, folder):
     if iso.drop:
         os.chown(folder, iso.user.uid, iso.user.gid)
     limits = iso.test
-    r = sandboxed([binary, "--list-test-cases", "--reporters=xml"], limits, iso, writable=[folder],
+    r = sandboxed([binary, "--list-test-cases", "--reporters=xml"], limits, iso, scratch=folder,
                   env=clean_env(folder), keep=int(limits.output_mb * (1 << 20)),
                   readable=test_readable(binary))
     return listed_cases(r)
@@ -190,9 +189,11 @@ def doctest_filter(name):
 
 
 def run_case(binary, suite, name, iso, folder):
-    """One test case in its own sandboxed process, in a fresh writable folder, with the test
-    limits. doctest writes its results to a file there, so what the student's code prints is
-    only counted against the output limit, never read as a result."""
+    """One test case in its own sandboxed process, in a fresh writable folder (isolated: a
+    tmpfs of the test's disk limit, so no test fills the grading disk), with the test
+    limits. doctest writes its results to a file there (the one file that reaches the
+    host), so what the student's code prints is only counted against the output limit,
+    never read as a result."""
     os.makedirs(folder)
     if iso.drop:
         os.chown(folder, iso.user.uid, iso.user.gid)
@@ -200,8 +201,8 @@ def run_case(binary, suite, name, iso, folder):
     cmd = [binary, "--test-suite=" + doctest_filter(suite), "--test-case=" + doctest_filter(name),
            "--reporters=xml", "--no-version", f"--out={result}"]
     try:
-        r = sandboxed(cmd, iso.test, iso, writable=[folder], env=clean_env(folder), keep=1 << 16,
-                      readable=test_readable(binary))
+        r = sandboxed(cmd, iso.test, iso, scratch=folder, outputs=[result], env=clean_env(folder),
+                      keep=1 << 16, readable=test_readable(binary))
         data = read_result(result)
         found = [c for c in case_results(data) if c.name == name] if data else []
     finally:

@@ -1,5 +1,6 @@
-"""Why grading one tree stops: GradeError (it cannot start or go on) and OutOfTime (its
-overall deadline passed). Raised by the grading modules, caught by grade.py's callers."""
+"""Why grading one tree stops: GradeError (it cannot start or go on), OutOfTime (its
+overall deadline passed) and NotGraded (the grading machine failed). Raised by the grading
+modules, caught by grade.py's callers."""
 
 
 class GradeError(Exception):
@@ -15,3 +16,12 @@ class GradeError(Exception):
 class OutOfTime(Exception):
     """The whole grading of one tree passed its deadline (the class grader's
     --student-timeout)."""
+
+
+NOT_GRADED_EXIT = 75  # ./workbook grade's exit status for NotGraded (sysexits' EX_TEMPFAIL)
+
+
+class NotGraded(Exception):
+    """The grading machine failed, not the student's code: its disk is full, staging the
+    submission failed. No points and nothing cached: the message says why, and grading the
+    same submission again once that is fixed gives its grade."""

@@ -33,9 +33,14 @@ the reason is each failure's message), and with --json FILE the same results per
 as JSON (exercise, title, step, points, max, status, reason, case, seconds).
 WORK/build is kept between runs, so grading the next tree rebuilds only what changed. The
 test cases run in folders under WORK that go when grading ends: nothing is left in /tmp.
+The student's tree is read, never followed: regular files only, within the submission
+reader's limits; a link, device or FIFO in its steps/ is left out and a note says why.
+When the grading machine fails (its disk full), nothing is graded: the exit status is 75
+and the message says why; grade again once that is fixed.
 """
 import argparse
 import dataclasses
+import errno
 import os
 import shutil
 import signal
@@ -47,13 +52,14 @@ import traceback
 from dataclasses import dataclass
 
 from . import ROOT, sandbox
-from .box import Isolation, check_user_access, refuse_without_isolation
+from .box import Isolation, check_user_access, disk_trouble, refuse_without_isolation
 from .build_and_run import configure, grade_step
-from .errors import GradeError, OutOfTime
+from .errors import NOT_GRADED_EXIT, GradeError, NotGraded, OutOfTime
 from .exercises import BEGIN, exercises, step_sources
 from .grade_report import exercise_row, print_table, printable, results_by_exercise, say, write_json, write_junit
 from .grading_tree import assemble, hidden_copies, share_tree
 from .strict_numbers import MAX_JOBS, MAX_MB, MAX_SECONDS, decimal, integer, step_list
+from .users import grading_user
 
 
 @dataclass
@@ -131,9 +137,10 @@ def scrub_solution_outputs(work, log=None):
 def grade(student, opts, out=None, log=None, deadline=None, partial=False):
     """Grades the tree `student` with GradeOptions `opts`: the points table to `out`
     (default stdout), progress to `log` (default stderr), the JUnit XML (and the JSON) to
-    their files. Raises GradeError when grading cannot start or go on, OutOfTime once
-    time.monotonic() passes `deadline` (with `partial`: the exercises not graded by then
-    fail with that reason instead), sandbox.Stopped after sandbox.stop_all()."""
+    their files. Raises GradeError when grading cannot start or go on, NotGraded when the
+    grading machine fails (its disk full), OutOfTime once time.monotonic() passes
+    `deadline` (with `partial`: the exercises not graded by then fail with that reason
+    instead), sandbox.Stopped after sandbox.stop_all()."""
     started = time.monotonic()
     out = out or sys.stdout
     student_path = os.path.abspath(student)
@@ -153,30 +160,60 @@ def grade(student, opts, out=None, log=None, deadline=None, partial=False):
         if os.geteuid() != 0:
             raise GradeError("grade: --user runs student code as another user: that needs root", 2)
         try:
-            user = sandbox.grading_user(opts.user)
+            user = grading_user(opts.user)
         except ValueError as e:
             raise GradeError(f"grade: --user: {e}", 2) from None
     elif opts.no_isolation and os.geteuid() == 0:
         say("WARNING: as root without --user, student code runs as root", log)
     hidden = opts.hidden and os.path.abspath(opts.hidden)
     unreadable = (ROOT, student_path, hidden, os.path.expanduser("~"), "/home", "/root")
+    # A build's files: the largest the grading build makes is a few tens of MB; one file of
+    # a student's build (a huge initialised array, say) stops there.
     iso = Isolation(not opts.no_isolation,
-                    build=sandbox.Limits(opts.build_timeout, opts.build_memory, opts.output, file_mb=2048),
+                    build=sandbox.Limits(opts.build_timeout, opts.build_memory, opts.output, file_mb=512),
                     test=sandbox.Limits(opts.timeout, opts.memory, opts.output), jobs=opts.jobs,
                     hidden=tuple(dict.fromkeys(p for p in unreadable if p)), deadline=deadline, log=log,
-                    user=user)
-    os.makedirs(work, exist_ok=True)
+                    user=user, disk=work)
+    try:
+        return _grade(student_path, opts, out, log, partial, work, all_ex, steps, hidden, iso, started)
+    except OSError as e:
+        if e.errno in (errno.ENOSPC, errno.EDQUOT):
+            raise NotGraded(f"the grading disk is full ({e.strerror}: {printable(str(e.filename))})") from e
+        raise
+
+
+def _grade(student_path, opts, out, log, partial, work, all_ex, steps, hidden, iso, started):
+    os.makedirs(os.path.join(work, "build"), exist_ok=True)
+    trouble = disk_trouble(work)
+    if trouble:
+        raise NotGraded(trouble)
     notes = assemble(student_path, hidden, work, steps)
+    if os.geteuid() == 0:  # student code runs as another user (iso.user, or the sandbox's own)
+        os.chmod(os.path.join(work, "build"), 0o755)
+        share_tree(os.path.join(work, "src"))
     if iso.drop:
         os.chmod(work, 0o755)
-        share_tree(os.path.join(work, "src"))
         solutions = [os.path.join(ROOT, rel) for rel in solution_files()[:1]]
         check_user_access(iso, work, solutions + [hidden] + hidden_copies(work) + list(opts.private))
-        notes.append(f"student code ran without isolation, as user {user.name}")
+        notes.append(f"student code ran without isolation, as user {iso.user.name}")
     elif not iso.isolate:
         notes.append("student code ran without isolation (--no-isolation)")
-    configure(work, iso)
     rows = []
+
+    def out_of_time(k, what):
+        # With `partial`, the exercises not graded in time fail with that reason.
+        if not partial:
+            raise OutOfTime()
+        why = ("time limit", "not graded: the grading ran past its overall time limit")
+        for later in steps[k:]:
+            rows.extend(exercise_row(e, later, why, [], 0.0) for e in all_ex if f"{e.step:02d}" == later)
+        say(f"out of time {what}: its exercises and the later ones are not graded", log)
+
+    try:
+        configure(work, iso)
+    except OutOfTime:
+        out_of_time(0, "while configuring")
+        steps = []
     # The test cases' folders: in WORK (the clone's build/ by default), not the shared /tmp,
     # and removed when grading ends, however it ends.
     with tempfile.TemporaryDirectory(prefix="scratch-", dir=work, ignore_cleanup_errors=True) as scratch:
@@ -189,12 +226,7 @@ def grade(student, opts, out=None, log=None, deadline=None, partial=False):
             try:
                 step_rows = grade_step(work, number, items, iso, scratch, notes, log, t0)
             except OutOfTime:
-                if not partial:
-                    raise
-                why = ("time limit", "not graded: the grading ran past its overall time limit")
-                for later in steps[k:]:
-                    rows += [exercise_row(e, later, why, [], 0.0) for e in all_ex if f"{e.step:02d}" == later]
-                say(f"out of time at step {number}: its exercises and the later ones are not graded", log)
+                out_of_time(k, f"at step {number}")
                 break
             rows += step_rows
     notes = [printable(n) for n in notes]
@@ -224,7 +256,8 @@ def grade_into(folder, tree, opts, limit=None, partial=False):
     grade: points.txt (the table), grade.log (the progress), grade.xml and grade.json. A
     failure to grade is a Report with its code and the log's last line, not an exception;
     `limit`: seconds for the whole grading (OutOfTime: code None; with `partial`, the
-    exercises not graded in time fail instead). sandbox.Stopped passes."""
+    exercises not graded in time fail instead; NotGraded: code NOT_GRADED_EXIT, the last
+    line "not graded: why"). sandbox.Stopped passes."""
     os.makedirs(folder, exist_ok=True)
     opts = dataclasses.replace(opts, junit=os.path.join(folder, "grade.xml"),
                                json=os.path.join(folder, "grade.json"))
@@ -240,6 +273,9 @@ def grade_into(folder, tree, opts, limit=None, partial=False):
             graded = grade(tree, opts, out, log, deadline, partial)
         except OutOfTime:
             code = None
+        except NotGraded as e:  # the machine's failure: the last line says why
+            code = NOT_GRADED_EXIT
+            log.write(f"not graded: {e}\n")
         except (GradeError, SystemExit) as e:
             code = e.code if isinstance(e.code, int) else 1
             if str(e):
@@ -297,8 +333,12 @@ def main(argv):
     try:
         grade(args.student, opts)
     except GradeError as e:
-        print(e, file=sys.stderr)
+        print(printable(str(e)), file=sys.stderr)
         return e.code
+    except NotGraded as e:
+        print(f"grade: not graded: {e}; a failure of the grading machine, not of the student's code: "
+              "grade again once it is fixed", file=sys.stderr)
+        return NOT_GRADED_EXIT
     return 0
 
 

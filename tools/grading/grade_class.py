@@ -31,12 +31,16 @@ import signal
 import sys
 import threading
 import time
+import traceback
 from concurrent.futures import ThreadPoolExecutor, as_completed
 
 from . import ROOT, sandbox
 from .strict_numbers import MAX_JOBS, MAX_SECONDS, decimal, integer, step_list
+from .cgroups import usable_cpus
+from .errors import NOT_GRADED_EXIT
 from .exercises import exercises
 from .grade import GradeOptions, grade_into
+from .grade_report import one_line
 from .kit import tracked_files
 from .submissions import SubmissionError, content_hash, is_submission, read_submission, stage, student_name
 
@@ -49,7 +53,8 @@ GRADER_FILES = ("tools/grading/grade.py", "tools/grading/grade_report.py", "tool
 
 
 def say(text):
-    print(f"[class] {text}", file=sys.stderr, flush=True)
+    """A progress line: a student's or a file's name in it is escaped (one_line)."""
+    print(f"[class] {one_line(text)}", file=sys.stderr, flush=True)
 
 
 def run_grader(tree, work, report_dir, steps=None, hidden=None, timeout=60.0, jobs=1,
@@ -163,16 +168,41 @@ def prime(workers, count, opts, key):
     return results
 
 
+RETRY = ", retry"  # ends the reason of a row the grading machine failed (nothing cached)
+
+
 def grade_one(sub, workers, opts):
-    """Grades one submission: {student, hash, status, build, rows, total, seconds, ...}."""
-    result = {"student": sub["student"], "source": sub["entry"], "hash": sub["hash"]}
-    report = os.path.join(opts.out, "students", sub["student"])
+    """Grades one submission: {student, hash, status, build, rows, total, seconds, ...}.
+    Whatever goes wrong with it (its archive, staging it, the grader) is its own row's
+    reason, "not graded: ...": the class goes on."""
+    result = {"student": sub["student"], "source": sub["entry"], "hash": sub["hash"], "seconds": 0.0}
     if sub.get("error"):
-        result.update(status="error", build=f"not graded: {sub['error']}", rows=[], seconds=0.0)
+        result.update(status="error", build=f"not graded: {sub['error']}", rows=[], total=0)
         return result
+    try:
+        return _grade_one(sub, workers, opts, result)
+    except sandbox.Stopped:
+        raise
+    except Exception as e:  # a failure of the grader or the machine, not a grade
+        traceback.print_exc()
+        why = f"{type(e).__name__}: {e}" if not isinstance(e, OSError) else str(e)
+        result.update(status="error", build=f"not graded: the grader failed ({why[:200]}){RETRY}",
+                      rows=[], total=0)
+        return result
+
+
+def _grade_one(sub, workers, opts, result):
+    report = os.path.join(opts.out, "students", sub["student"])
     i = workers.take()
     try:
-        tree = stage(sub["files"], os.path.join(workers.dir(i), "student"))
+        try:
+            tree = stage(sub["files"], os.path.join(workers.dir(i), "student"))
+        except SubmissionError as e:
+            result.update(status="error", build=f"not graded: {e}", rows=[], total=0)
+            return result
+        except OSError as e:
+            result.update(status="error", build=f"not graded: staging failed ({e}){RETRY}", rows=[], total=0)
+            return result
         r = run_grader(tree, workers.dir(i), report, opts.steps, opts.hidden, opts.timeout,
                        opts.compile_jobs, opts.no_sandbox, opts.student_timeout)
     finally:
@@ -180,6 +210,8 @@ def grade_one(sub, workers, opts):
     result["seconds"] = round(r.seconds, 2)
     if r.code is None:
         result.update(status="error", build=f"grading ran out of time ({opts.student_timeout:g} s)", rows=[])
+    elif r.code == NOT_GRADED_EXIT:
+        result.update(status="error", build=f"{r.last_line[:300]}{RETRY}", rows=[])
     elif r.code != 0:
         result.update(status="error", build=f"the grader failed (exit {r.code}): {r.last_line[:200]}", rows=[])
     else:
@@ -188,6 +220,7 @@ def grade_one(sub, workers, opts):
         result.update(status="graded", rows=rows,
                       build="ok" if not broken else "step " + ",".join(broken) + " does not compile")
     result["total"] = sum(r["points"] for r in result["rows"])
+    os.makedirs(report, exist_ok=True)
     with open(os.path.join(report, "result.json"), "w") as f:
         json.dump(result, f, indent=1)
     return result
@@ -208,6 +241,13 @@ def discover(folder):
     return subs
 
 
+def cell(text):
+    """A text cell of class.csv: on one line, escaped (one_line), and never a formula (a
+    spreadsheet runs a cell that starts with = + - @: a quote in front keeps it text)."""
+    text = one_line(text)
+    return "'" + text if text[:1] in ("=", "+", "-", "@") else text
+
+
 def write_csv(path, results, ex_list):
     with open(path + ".tmp", "w", newline="") as f:
         w = csv.writer(f)
@@ -215,8 +255,8 @@ def write_csv(path, results, ex_list):
         maximum = sum(e.points for e in ex_list)
         for r in sorted(results, key=lambda r: r["student"]):
             got = {row["exercise"]: row["points"] for row in r["rows"]}
-            w.writerow([r["student"]] + [got.get(e.id, 0) for e in ex_list] +
-                       [r.get("total", 0), maximum, r["build"], f"{r.get('seconds', 0):.1f}"])
+            w.writerow([cell(r["student"])] + [got.get(e.id, 0) for e in ex_list] +
+                       [r.get("total", 0), maximum, cell(r["build"]), f"{r.get('seconds', 0):.1f}"])
     os.replace(path + ".tmp", path)
 
 
@@ -281,7 +321,7 @@ median {sorted(totals)[len(totals) // 2] if totals else 0}. The table per studen
 <table><tr><th>exercise</th><th class=t>what</th><th>points</th><th>full points</th><th>zero</th>
 <th>mean</th><th class=t>most common first failure</th></tr>
 {''.join(rows_html)}</table>
-{'<h2>Not graded</h2><ul>' + ''.join(f'<li>{html.escape(r["student"])}: {html.escape(r["build"])}</li>' for r in errors) + '</ul>' if errors else ''}
+{'<h2>Not graded</h2><ul>' + ''.join(f'<li>{html.escape(one_line(r["student"]))}: {html.escape(one_line(r["build"]))}</li>' for r in errors) + '</ul>' if errors else ''}
 """
     with open(os.path.join(out, "index.html"), "w") as f:
         f.write(page)
@@ -303,7 +343,7 @@ def grade_class(opts):
     opts.all_ex = {e.id: e for e in all_ex}
     opts.hidden = os.path.abspath(opts.hidden) if opts.hidden else None
     opts.jobs = max(1, opts.jobs)
-    opts.compile_jobs = max(1, sandbox.usable_cpus() // opts.jobs)
+    opts.compile_jobs = max(1, usable_cpus() // opts.jobs)
     key = config_hash(opts.hidden, opts.steps, opts.timeout)
 
     subs = discover(opts.submissions)
@@ -313,8 +353,10 @@ def grade_class(opts):
         try:
             s["files"] = read_submission(s["path"])
             s["hash"] = content_hash(s["files"])
-        except (SubmissionError, OSError) as e:
+        except SubmissionError as e:
             s["error"], s["hash"] = str(e), ""
+        except Exception as e:  # an archive Python cannot read (encrypted, a broken stream)
+            s["error"], s["hash"] = f"cannot be read ({type(e).__name__}: {str(e)[:200]}){RETRY}", ""
 
     cache_path = os.path.join(opts.out, "cache.json")
     cache = {}
@@ -400,7 +442,7 @@ def main(argv):
     p.add_argument("submissions", help="folder with one folder, git repository or archive per student")
     p.add_argument("--out", default=os.path.join(ROOT, "build", "class-grades"),
                    help="where the results go (default build/class-grades)")
-    p.add_argument("--jobs", type=integer(1, MAX_JOBS), default=sandbox.usable_cpus(),
+    p.add_argument("--jobs", type=integer(1, MAX_JOBS), default=usable_cpus(),
                    help="students graded at once (default: the cores this process may use)")
     p.add_argument("--hidden", help="folder of extra doctest files stepNN*.cpp (as for grade)")
     p.add_argument("--steps", type=step_list, help="grade only these steps, e.g. 01,03")

@@ -21,6 +21,18 @@ def printable(text):
                             else f"\\u{ord(m.group()):04x}", text)
 
 
+# Bidirectional controls: they reorder what a terminal or a spreadsheet shows around them.
+_BIDI = re.compile("[\u200e\u200f\u202a-\u202e\u2066-\u2069]")
+
+
+def one_line(text):
+    """printable(text) on one line, for a name (a student's, an archive member's) in a
+    progress line or a table cell: newlines, tabs and bidirectional controls written as
+    escapes too, so a name can neither run a terminal's escape sequences nor forge a line."""
+    text = printable(str(text)).replace("\n", "\\n").replace("\t", "\\t")
+    return _BIDI.sub(lambda m: f"\\u{ord(m.group()):04x}", text)
+
+
 def say(text, log=None):
     print(f"[grade] {text}", file=log or sys.stderr, flush=True)
 

@@ -44,8 +44,11 @@ import zipfile
 
 from . import ROOT, sandbox
 from .strict_numbers import MAX_SECONDS, decimal, step_list
+from .cgroups import usable_cpus
+from .errors import NOT_GRADED_EXIT
 from .exercises import exercises
 from .grade_class import run_grader
+from .grade_report import one_line
 from .kit import tracked_files
 from .submissions import ARCHIVE_SUFFIXES, SubmissionError, read_submission, stage
 
@@ -208,7 +211,7 @@ def prime(args):
     user = student_user(config, isolated)
     report = os.path.join(work, "reference")
     r = run_grader(ROOT, work, report, config["steps"], hidden, config["timeout"],
-                   sandbox.usable_cpus(), not isolated, user=user)
+                   usable_cpus(), not isolated, user=user)
     os.chmod(report, 0o700)
     rows = r.results
     missing = [x["exercise"] for x in rows if not x["passed"]]
@@ -219,7 +222,7 @@ def prime(args):
               f"see {report}", file=sys.stderr)
         return 1
     how = "in bubblewrap" if isolated else (f"as user {user}" if user else "without isolation")
-    print(f"[gradescope] grading build primed in {r.seconds:.0f} s ({sandbox.usable_cpus()} CPUs, "
+    print(f"[gradescope] grading build primed in {r.seconds:.0f} s ({usable_cpus()} CPUs, "
           f"student code {how}): the reference gets full points", file=sys.stderr)
     return 0
 
@@ -318,9 +321,9 @@ def grade_submission(args, started, write):
     try:
         files = submission_files(os.path.join(args.root, "submission"))
     except (SubmissionError, OSError) as e:
-        write(failure(f"The submission cannot be graded: {e}. Submit your workbook tree (the folder "
-                      "with steps/) or a zip of it."))
-        print(f"[gradescope] not graded: {e}", file=sys.stderr)
+        write(failure(f"The submission cannot be graded: {one_line(e)}. Submit your workbook tree (the "
+                      "folder with steps/) or a zip of it."))
+        print(f"[gradescope] not graded: {one_line(e)}", file=sys.stderr)
         return 0
     limit = float(config.get("limit", DEFAULT_LIMIT))
     with tempfile.TemporaryDirectory(prefix="boxes-submission-") as tmp:
@@ -328,7 +331,7 @@ def grade_submission(args, started, write):
         report = os.path.join(tmp, "report")
         isolated = isolation()
         graded = run_grader(tree, work, report, config["steps"], hidden, config["timeout"],
-                            sandbox.usable_cpus(), not isolated, user=student_user(config, isolated),
+                            usable_cpus(), not isolated, user=student_user(config, isolated),
                             limit=max(1.0, limit - (time.monotonic() - started)), partial=True)
         with open(os.path.join(report, "points.txt"), errors="replace") as f:
             table = f.read()
@@ -339,6 +342,11 @@ def grade_submission(args, started, write):
     if graded.code is None:
         write(failure(f"The grading ran past its time limit of {limit:g} s before any exercise was "
                       "graded: zero points. Your instructor sees its log."))
+        return 0
+    if graded.code == NOT_GRADED_EXIT:
+        write(failure(f"Not graded: {graded.last_line[len('not graded: '):]}. A problem of the "
+                      "autograder's machine, not a verdict on your code: submit again."))
+        print(f"[gradescope] {graded.last_line}", file=sys.stderr)
         return 0
     if graded.code != 0:
         write(failure(GRADER_FAILED))

@@ -7,7 +7,9 @@ import re
 from . import ROOT
 from .errors import GradeError
 from .exercises import SOURCE_SUFFIXES, step_dirs
+from .grade_report import printable
 from .kit import strip_solutions, tracked_files
+from .submissions import SubmissionError, read_tree
 
 
 def read(path):
@@ -15,17 +17,18 @@ def read(path):
         return f.read()
 
 
-def student_sources(student, step_names):
-    """{relative path: text} of the student's sources in the reference's step folders."""
-    owned = {}
-    for name in step_names:
-        base = os.path.join(student, "steps", name)
-        for d, _, files in os.walk(base):
-            for f in files:
-                if f.endswith(SOURCE_SUFFIXES):
-                    path = os.path.join(d, f)
-                    owned[os.path.relpath(path, student)] = read(path)
-    return owned
+def student_sources(student, step_names, notes):
+    """{relative path: text} of the student's sources in the reference's step folders, read
+    as the submission reader reads a folder (submissions.read_tree): regular files only,
+    never through a link, within its limits. What it refused, and why, goes into `notes`."""
+    refused = []
+    try:
+        files = read_tree(student, refused)
+    except SubmissionError as e:
+        raise GradeError(printable(f"grade: {student}: {e}")) from None
+    notes += refused
+    return {rel: data.decode("utf-8", errors="replace") for rel, data in files.items()
+            if rel.split("/")[1] in step_names}
 
 
 def hidden_tests(hidden, step_numbers):
@@ -105,7 +108,7 @@ def assemble(student, hidden, work, steps):
         else:
             with open(path, "rb") as f:
                 files[rel] = f.read()
-    owned = student_sources(student, step_names)
+    owned = student_sources(student, step_names, notes)
     if not owned:
         notes.append(f"no step sources found under {student}/steps: every exercise is a stub")
     for rel, text in owned.items():

@@ -17,7 +17,8 @@ usage: ./workbook mutants [N.M | NN | N.M-name ...] [--list] [--check]
   --list   the catalogue
   --check  only check the catalogue: every patch applies, names its case, has a hint
   --safeguards  the hard cases' safeguards removed instead (tests/safeguards,
-           tools/grading/safeguards.py): exactly the named hard cases must fail
+           tools/grading/safeguards.py, which ./workbook runs for it): exactly the named
+           hard cases must fail
 
 Each mutant is applied to a private copy of the tree (build/mutants/tree, kept between
 runs so that its build is incremental), the exercise's test program alone is built, the
@@ -36,6 +37,7 @@ import time
 from dataclasses import dataclass
 
 from . import ROOT
+from .. import build
 from .kit import tracked_files
 
 MUTANTS_DIR = "tests/mutants"
@@ -194,19 +196,19 @@ def sync_tree(root, tree):
                 os.remove(os.path.join(base, n))
 
 
+def release_tree(tree):
+    """The private tree's release build (tools/build.py). No step programs: the exercise
+    suites need only the step's library. No link-time optimisation either: it would add a
+    slower link to every mutant's build."""
+    return build.Tree.of_preset(tree, "release", BOXES_TESTS_BUILD_PROGRAMS="OFF", BOXES_LTO="OFF")
+
+
 def build_dir(tree):
-    return os.path.join(tree, "build", "release")
+    return release_tree(tree).build
 
 
 def configure(tree, log):
-    if os.path.isfile(os.path.join(build_dir(tree), "build.ninja")):
-        return True
-    # No step programs: the exercise suites need only the step's library. No link-time
-    # optimisation either: it would add a slower link to every mutant's build.
-    r = subprocess.run(["cmake", "--preset", "release", "-DBOXES_TESTS_BUILD_PROGRAMS=OFF",
-                        "-DBOXES_LTO=OFF"],
-                       cwd=tree, stdout=log, stderr=subprocess.STDOUT)
-    return r.returncode == 0
+    return build.configure(release_tree(tree), log=log).ok
 
 
 def build_and_test(tree, step, exercises, log, title):
@@ -216,9 +218,7 @@ def build_and_test(tree, step, exercises, log, title):
     log.write(f"\n==== {title}: build {target}\n")
     log.flush()
     # Two jobs: the machine is shared, and one mutant rebuilds a file or two.
-    b = subprocess.run(["cmake", "--build", build_dir(tree), "--target", target, "-j2"],
-                       stdout=log, stderr=subprocess.STDOUT)
-    if b.returncode != 0:
+    if not build.build(release_tree(tree), [target], jobs=2, log=log).ok:
         return "no build", []
     label = "^exercise (" + "|".join(re.escape(e) for e in exercises) + ")$"
     t = subprocess.run(["ctest", "--test-dir", build_dir(tree), "-L", label,
@@ -314,12 +314,13 @@ def private_tree():
 
 
 def main(argv):
-    if "--safeguards" in argv:
-        from . import safeguards
-        return safeguards.main(argv)
     args = [a for a in argv if not a.startswith("-")]
     flags = [a for a in argv if a.startswith("-")]
     for f in flags:
+        if f == "--safeguards":
+            print("mutants: the safeguards are python3 -m tools.grading.safeguards (./workbook mutants "
+                  "--safeguards runs it)", file=sys.stderr)
+            return 2
         if f not in ("--list", "--check", "-h", "--help"):
             print(f"mutants: unknown option '{f}' (use: mutants [N.M ...] [--list] [--check])",
                   file=sys.stderr)

@@ -32,8 +32,9 @@ import time
 from dataclasses import dataclass, field
 
 from . import ROOT
+from .. import build
 from .mutants import TEST_TIMEOUT, applied_marker, build_dir, configure, git_apply
-from .mutants import list_or_check, private_tree
+from .mutants import list_or_check, private_tree, release_tree
 
 SAFEGUARDS_DIR = "tests/safeguards"
 NAME = re.compile(r"^[a-z0-9][a-z0-9-]*\.patch$")
@@ -174,9 +175,7 @@ def build_and_run(tree, named, log, title):
     programs = {p for p, _ in named}
     log.write(f"\n==== {title}: build {' '.join(sorted(programs))}\n")
     log.flush()
-    b = subprocess.run(["cmake", "--build", build_dir(tree), "--target", *sorted(programs), "-j2"],
-                       stdout=log, stderr=subprocess.STDOUT)
-    if b.returncode != 0:
+    if not build.build(release_tree(tree), sorted(programs), jobs=2, log=log).ok:
         return "no build", []
     chosen = chosen_tests(listed_tests(tree), named)
     missing = [ctest_name(n) for n in named if ctest_name(n) not in chosen]

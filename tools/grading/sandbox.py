@@ -1,13 +1,21 @@
 """Runs one untrusted command isolated and limited: the grader's student builds and test
-runs (grade.py imports this module), and tools/grading/sandbox.sh on the command line.
+runs (box.py imports this module), and tools/grading/sandbox.sh on the command line. Its
+parts: bubblewrap.py (the command line: what the command sees), users.py (the users it
+runs as), cgroups.py (the CPUs to use, the pids cgroup); here the run and its limits.
 
 usage: tools/grading/sandbox.sh [--time S] [--memory MB] [--output MB] [--processes N]
                                 [--dir DIR] [--no-isolation [--user NAME]] -- COMMAND [ARGS...]
 
-Isolation (bubblewrap): the whole system read-only, DIR (default: a fresh temporary folder)
-the only writable place and the working directory, a private /tmp of at most the output
-limit, no network (an own, empty network namespace), an own PID namespace, no capabilities
-and no further user namespaces (even when the grader runs as root), killed with its parent.
+Isolation (bubblewrap): the command sees the system's programs and libraries read-only
+(/usr, /etc and the links of a merged /usr; nothing else of the machine: no home, no
+/work, /srv or /var, no other student's folder), the folders it is given (DIR, default: a
+fresh temporary folder, the only writable place and the working directory), a private /tmp
+and /dev/shm of at most the output limit each, no network (an own, empty network
+namespace), an own PID namespace, no capabilities, killed with its parent. As root it runs
+as a user id of its own that owns no file of the machine (a fresh one per command, from
+BOXES_SANDBOX_UID_BASE, default 2130706432; setpriv drops to it inside the sandbox) and DIR
+is lent to that user for the run; otherwise as "nobody" in a user namespace, with no
+further user namespaces.
 Limits (setrlimit, inherited by every process the command starts): wall-clock seconds (the
 whole run), CPU seconds (per process: the wall time times the cores, so a busy loop in
 every thread still stops), address space per process, the size of any file written, and
@@ -28,15 +36,12 @@ DIR/stderr.txt (their first bytes, up to the output limit) and one line
 "sandbox: RESULT" goes to stdout: ok | failed: exit N | time limit | memory limit |
 output limit | crashed: SIGNAME. Exit status: 0 ok, 1 failed, 3 limit or crash, 2 usage
 or refused (bubblewrap cannot create namespaces here and no --no-isolation).
-Environment: BOXES_BWRAP names the bubblewrap program (default: bwrap on PATH).
+Environment: BOXES_BWRAP names the bubblewrap program (default: bwrap on PATH);
+BOXES_SANDBOX_SYSTEM adds folders the sandbox shows read-only (colon-separated, e.g. a
+compiler under /opt).
 """
 import argparse
-import ctypes
-import functools
-import itertools
-import math
 import os
-import pwd
 import resource
 import selectors
 import shutil
@@ -48,10 +53,12 @@ import threading
 import time
 from dataclasses import dataclass
 
-try:  # a module of tools.grading, or run as a script (sandbox.sh)
-    from .strict_numbers import MAX_MB, MAX_SECONDS, decimal, integer
-except ImportError:
-    from strict_numbers import MAX_MB, MAX_SECONDS, decimal, integer
+from . import ROOT
+from .bubblewrap import become, bwrap_prefix, bwrap_program
+from .cgroups import make_pids_cgroup, remove_cgroup, usable_cpus
+from .strict_numbers import MAX_MB, MAX_SECONDS, decimal, integer
+from .users import box_user, become_subreaper, grading_user, kill_user, lent, reap_orphans, user_lock, user_tasks
+
 
 # What the C++ runtime, glibc, GCC and Python print when an allocation is refused: under an
 # address-space limit that is the normal way a memory hog ends.
@@ -66,97 +73,10 @@ class Limits:
     output_mb: float = 16.0  # stdout + stderr together, and any one file written
     file_mb: float = 0.0  # any one file written, when it must differ from output_mb (a build)
     processes: int = 256  # processes and threads the command may have at once
+    disk_mb: float = 64.0  # all files of a scratch folder together (run's `scratch`, isolated)
 
     def cpu_seconds(self):
         return int(self.seconds * usable_cpus()) + 1
-
-
-@dataclass(frozen=True)
-class User:
-    """The unprivileged account that runs commands without isolation when the grader is
-    root (grading_user)."""
-    name: str
-    uid: int
-    gid: int
-
-
-def grading_user(name):
-    """The User called `name`; ValueError (one line) when there is none or it is root."""
-    try:
-        entry = pwd.getpwnam(name)
-    except KeyError:
-        raise ValueError(f"there is no user {name!r} (as root: useradd --system --no-create-home "
-                         f"--shell /usr/sbin/nologin {name})") from None
-    if entry.pw_uid == 0 or entry.pw_gid == 0:
-        raise ValueError(f"user {name!r} is root or in root's group: student code needs an "
-                         "unprivileged user")
-    return User(name, entry.pw_uid, entry.pw_gid)
-
-
-def _cpu_quota(folder):
-    """The CPUs one cgroup folder's quota allows (cgroup v2 cpu.max, v1 cpu.cfs_quota_us
-    over cpu.cfs_period_us), or None without a quota there."""
-    try:
-        with open(os.path.join(folder, "cpu.max")) as f:
-            quota, period = (f.read().split() + ["100000"])[:2]
-        return None if quota == "max" else int(quota) / int(period)
-    except (OSError, ValueError, ZeroDivisionError):
-        pass
-    try:
-        with open(os.path.join(folder, "cpu.cfs_quota_us")) as f:
-            quota = int(f.read())
-        with open(os.path.join(folder, "cpu.cfs_period_us")) as f:
-            period = int(f.read())
-        return None if quota <= 0 or period <= 0 else quota / period
-    except (OSError, ValueError):
-        return None
-
-
-def cgroup_cpu_quota(proc_cgroup="/proc/self/cgroup", mounts="/proc/self/mounts"):
-    """The tightest CPU quota on this process's cgroup and its parents (in CPUs, e.g. 0.5
-    for Gradescope's default half a virtual CPU), or None when there is none. In a container
-    the cgroup's path may not exist below the mount (it is the mount's root): then the
-    mount's root is read."""
-    try:
-        with open(proc_cgroup) as f:
-            entries = [line.strip().split(":", 2) for line in f if line.count(":") >= 2]
-        with open(mounts) as f:
-            mounted = [line.split() for line in f]
-    except OSError:
-        return None
-    quotas = []
-    for _, controllers, path in entries:
-        for m in mounted:
-            if len(m) < 4:
-                continue
-            if not ((controllers == "" and m[2] == "cgroup2") or
-                    (m[2] == "cgroup" and "cpu" in controllers.split(",") and "cpu" in m[3].split(","))):
-                continue
-            folder = os.path.normpath(os.path.join(m[1], path.lstrip("/")))
-            while not os.path.isdir(folder) and folder.startswith(m[1] + "/"):
-                folder = os.path.dirname(folder)
-            while True:
-                q = _cpu_quota(folder)
-                if q is not None:
-                    quotas.append(q)
-                if folder == m[1] or not folder.startswith(m[1] + "/"):
-                    break
-                folder = os.path.dirname(folder)
-    return min(quotas) if quotas else None
-
-
-@functools.cache  # neither changes while the grader runs
-def usable_cpus():
-    """The CPUs this process may use: its affinity, cut to the cgroup's CPU quota (rounded
-    up, at least 1). In a container os.cpu_count() is the host's."""
-    try:
-        cpus = len(os.sched_getaffinity(0))
-    except (AttributeError, OSError):
-        cpus = os.cpu_count() or 1
-    quota = cgroup_cpu_quota()
-    if quota is not None:
-        cpus = min(cpus, max(1, math.ceil(quota)))
-    return max(1, cpus)
 
 
 @dataclass
@@ -178,7 +98,11 @@ class Stopped(Exception):
 
 
 _stop = threading.Event()
+
+
 _live = set()  # the Popen of every command running now (the class grader runs them on threads)
+
+
 _live_lock = threading.Lock()
 
 
@@ -195,10 +119,6 @@ def stop_all():
             os.killpg(p.pid, signal.SIGKILL)
         except ProcessLookupError:
             pass
-
-
-def bwrap_program():
-    return os.environ.get("BOXES_BWRAP") or shutil.which("bwrap") or ""
 
 
 def isolation_problem():
@@ -226,232 +146,6 @@ def isolation_problem():
     return f"bubblewrap cannot create namespaces here ({first[:200]})"
 
 
-@functools.cache
-def _bwrap_help(program):
-    try:
-        r = subprocess.run([program, "--help"], capture_output=True, text=True, timeout=30)
-    except (OSError, subprocess.TimeoutExpired):
-        return ""
-    return r.stdout + r.stderr
-
-
-def bwrap_has(option):
-    """Whether this bubblewrap knows a command-line option (--disable-userns came with
-    0.8; Ubuntu 22.04 has 0.6)."""
-    return option in _bwrap_help(bwrap_program()).split()
-
-
-def _namespaces():
-    # An own user namespace as "nobody" with no capabilities: root outside gets no power
-    # inside (no remounting the read-only system, no raising the limits). Where bubblewrap
-    # is older than 0.8 the sandbox may create further user namespaces; the mounts it
-    # inherits stay locked in them, and the limits were set outside.
-    flags = ["--unshare-all", "--unshare-user", "--uid", "65534", "--gid", "65534", "--cap-drop", "ALL"]
-    if bwrap_has("--disable-userns"):
-        flags.append("--disable-userns")
-    return flags + ["--die-with-parent", "--new-session"]
-
-
-def bwrap_prefix(writable, cwd, tmp_bytes, hidden=(), readable=()):
-    """bubblewrap arguments: the system read-only, `hidden` folders replaced by empty ones,
-    `readable` folders (inside hidden ones) shown again read-only, `writable` folders
-    read-write, a private /tmp of tmp_bytes, /dev and /proc of the sandbox's own."""
-    prefix = [bwrap_program(), "--ro-bind", "/", "/", "--dev", "/dev", "--proc", "/proc"]
-    covers = []
-    for d in hidden:
-        inside_another = any(d != h and d.startswith(h.rstrip("/") + "/") for h in list(hidden) + ["/tmp"])
-        if os.path.isdir(d) and d not in ("/", "/tmp") and not inside_another:
-            covers.append(d)
-            prefix += ["--tmpfs", d]
-    prefix += (["--size", str(int(tmp_bytes))] if bwrap_has("--size") else []) + ["--tmpfs", "/tmp"]
-    for d in readable:
-        if os.path.exists(d):
-            prefix += ["--ro-bind", d, d]
-    for d in writable:
-        prefix += ["--bind", d, d]
-    for d in covers:  # the empty covers stay read-only (after the binds made their mount points)
-        prefix += ["--remount-ro", d]
-    return prefix + ["--chdir", cwd] + _namespaces()
-
-
-def _user_tasks(uid):
-    """Threads of all processes whose real user is uid (what RLIMIT_NPROC counts)."""
-    count = 0
-    for entry in os.listdir("/proc"):
-        if not entry.isdigit():
-            continue
-        try:
-            with open(f"/proc/{entry}/status") as f:
-                fields = dict(line.split(":", 1) for line in f if ":" in line)
-            if int(fields["Uid"].split()[0]) == uid:
-                count += int(fields["Threads"])
-        except (OSError, KeyError, ValueError):
-            pass  # gone meanwhile
-    return count
-
-
-def _processes_of(uid, state=None):
-    """[(pid, parent pid)] of the processes whose real or effective user is uid, with
-    the state letter `state` only (e.g. "Z", a zombie) or, by default, those alive."""
-    found = []
-    for entry in os.listdir("/proc"):
-        if not entry.isdigit():
-            continue
-        try:
-            with open(f"/proc/{entry}/status") as f:
-                fields = dict(line.split(":", 1) for line in f if ":" in line)
-            ids = fields["Uid"].split()
-            letter = fields["State"].split()[0]
-            if uid in (int(ids[0]), int(ids[1])) and (letter == state if state else letter not in "ZX"):
-                found.append((int(entry), int(fields["PPid"])))
-        except (OSError, KeyError, ValueError, IndexError):
-            pass  # gone meanwhile
-    return found
-
-
-# A Python the user can run: the grader's own may live in root's home (pyenv, a venv).
-USER_PYTHON = shutil.which("python3", path="/usr/bin:/bin") or sys.executable
-
-# kill(-1) as the user: the kernel signals every process of that user in one pass (a fork
-# bomb cannot outrun it) and spares the caller.
-_KILLER = "import os\ntry:\n    os.kill(-1, 9)\nexcept OSError:\n    pass\n"
-
-
-def kill_user(user):
-    """SIGKILL to every process of `user`, until /proc shows none alive. Returns how many
-    were left (0 but for a kernel that cannot keep up)."""
-    for attempt in range(100):
-        if not _processes_of(user.uid):
-            return 0
-        subprocess.run([USER_PYTHON, "-I", "-S", "-c", _KILLER], user=user.uid, group=user.gid,
-                       extra_groups=[], env={}, stdin=subprocess.DEVNULL, stdout=subprocess.DEVNULL,
-                       stderr=subprocess.DEVNULL, check=False)
-        time.sleep(min(0.01 * attempt, 0.1))
-    return len(_processes_of(user.uid))
-
-
-_subreaper = False
-
-
-def _become_subreaper():
-    """The grader adopts the orphans of its commands (prctl PR_SET_CHILD_SUBREAPER), so it
-    can reap them: a container's first process may never reap, and unreaped zombies still
-    count against the user's RLIMIT_NPROC."""
-    global _subreaper
-    if not _subreaper:
-        try:
-            ctypes.CDLL(None, use_errno=True).prctl(36, 1, 0, 0, 0)  # PR_SET_CHILD_SUBREAPER
-        except (OSError, AttributeError):
-            pass
-        _subreaper = True
-
-
-def _reap_orphans(user):
-    # Only the user's zombies: every command of that user has ended (one runs at a time),
-    # so none of them is a Popen another thread still waits for.
-    for pid, parent in _processes_of(user.uid, state="Z"):
-        if parent == os.getpid():
-            try:
-                os.waitpid(pid, os.WNOHANG)
-            except ChildProcessError:
-                pass
-
-
-_user_locks = {}
-_user_locks_lock = threading.Lock()
-
-
-def _user_lock(user):
-    with _user_locks_lock:
-        return _user_locks.setdefault(user.uid, threading.Lock())
-
-
-@functools.cache  # the mounts do not change while the grader runs
-def _pids_hierarchies():
-    """Where a new pids cgroup can go: the cgroup v2 root when its pids controller is
-    enabled for children, then cgroup v1's pids hierarchy."""
-    v2, v1 = [], []
-    try:
-        with open("/proc/self/mounts") as f:
-            for line in f:
-                parts = line.split()
-                if len(parts) >= 4 and parts[2] == "cgroup2":
-                    v2.append(parts[1])
-                elif len(parts) >= 4 and parts[2] == "cgroup" and "pids" in parts[3].split(","):
-                    v1.append(parts[1])
-    except OSError:
-        return ()
-    usable = []
-    for mount in v2:
-        try:
-            with open(os.path.join(mount, "cgroup.subtree_control")) as f:
-                if "pids" in f.read().split():
-                    usable.append(mount)
-        except OSError:
-            pass
-    return tuple(usable + v1)
-
-
-_cgroup_serial = itertools.count(1)  # next() is atomic: the grader runs jobs on threads
-_stale_check = itertools.count(0)  # stale cgroups are looked for once per grader
-
-
-def _remove_stale_cgroups(hierarchy):
-    # Left by a grader that was killed: the empty cgroups of processes that are gone.
-    try:
-        names = os.listdir(hierarchy)
-    except OSError:
-        return
-    for name in names:
-        parts = name.split("-")
-        if len(parts) != 4 or parts[:2] != ["boxes", "sandbox"] or not parts[2].isdigit():
-            continue
-        try:
-            os.kill(int(parts[2]), 0)
-            continue  # its grader still runs
-        except ProcessLookupError:
-            pass
-        except OSError:
-            continue
-        try:
-            os.rmdir(os.path.join(hierarchy, name))
-        except OSError:
-            pass  # tasks still in it
-
-
-def _make_pids_cgroup(limit):
-    """As root: a new cgroup of at most `limit` tasks; its folder, or None where no pids
-    controller can be written."""
-    for hierarchy in _pids_hierarchies():
-        if next(_stale_check) == 0:
-            _remove_stale_cgroups(hierarchy)
-        serial = next(_cgroup_serial)
-        folder = os.path.join(hierarchy, f"boxes-sandbox-{os.getpid()}-{serial}")
-        try:
-            os.mkdir(folder)
-        except OSError:
-            continue
-        try:
-            with open(os.path.join(folder, "pids.max"), "w") as f:
-                f.write(str(limit))
-            return folder
-        except OSError:
-            _remove_cgroup(folder)
-    return None
-
-
-def _remove_cgroup(folder):
-    # Its tasks were killed with the sandbox; the kernel may take a moment to reap them.
-    for _ in range(50):
-        try:
-            os.rmdir(folder)
-            return
-        except FileNotFoundError:
-            return
-        except OSError:
-            time.sleep(0.05)
-
-
 _warned_no_pids = False
 
 
@@ -459,8 +153,8 @@ def _process_limit(limits):
     """(cgroup folder or None, RLIMIT_NPROC value or None) for a run."""
     global _warned_no_pids
     if os.geteuid() != 0:
-        return None, _user_tasks(os.getuid()) + limits.processes
-    folder = _make_pids_cgroup(limits.processes)
+        return None, user_tasks(os.getuid()) + limits.processes
+    folder = make_pids_cgroup(limits.processes)
     if folder is None and not _warned_no_pids:
         _warned_no_pids = True
         print("sandbox: WARNING: running as root without a writable pids cgroup: the number "
@@ -481,6 +175,7 @@ def _set_limits(limits, cgroup=None, nproc=None, user=None):
         resource.setrlimit(resource.RLIMIT_AS, (limits.memory_mb << 20,) * 2)
         resource.setrlimit(resource.RLIMIT_FSIZE, (file_bytes,) * 2)  # SIGXFSZ past it
         resource.setrlimit(resource.RLIMIT_CORE, (0, 0))
+        os.umask(0o022)  # what a build makes, the tests (another user, maybe) can read
         if user is not None:  # last: the limits above are set while still root
             os.setgroups([])
             os.setgid(user.gid)
@@ -496,56 +191,112 @@ def _signal_name(number):
 
 
 def run(cmd, limits, writable=(), cwd=None, isolate=True, keep=1 << 20, env=None, hidden=(),
-        readable=(), user=None):
+        readable=(), user=None, scratch=None, outputs=(), pass_fds=()):
     """Runs cmd under the sandbox and limits; returns a Result. `writable`: the folders the
-    command may write (cwd, default the first of them, is one of them when isolated);
-    `hidden`: folders it must not read (they look empty), `readable`: folders inside those
-    it reads after all. `user` (a User; without isolation, as root): the command runs as
-    that user under RLIMIT_NPROC, and every process of that user is killed when it ends
-    (`hidden`, `readable` and `writable` are then the file permissions' business). Raises
+    command may write (cwd, default the first of them or `scratch`, is one of them when
+    isolated); `readable`: the folders it may read besides the system (isolated; nothing
+    else of the machine is there); `hidden`: folders of the system it must not read (they
+    look empty). `scratch`: a folder the caller made, the command's working folder: when
+    isolated a fresh tmpfs of limits.disk_mb there, of which only the files `outputs`
+    (paths inside it, made empty here) reach the host; else the folder itself. `user` (a
+    User; as root): the command runs as that user; isolated, as root, without `user`: as a
+    fresh user id of its own (box_user). The writable folders, `scratch` and `outputs` are
+    that user's while it runs (lent, then the caller's again). Without isolation every
+    process of `user` is killed when the command ends, and `hidden`, `readable` and
+    `writable` are the file permissions' business. `pass_fds`: file descriptors the command
+    inherits (the judge's pipes); they are the command's: this process closes its copies as
+    soon as the command started, or when run returns or raises without starting it. Raises
     Stopped after stop_all()."""
+    fds = list(pass_fds)  # emptied once closed: each is closed exactly once
+    try:
+        return _run(cmd, limits, writable, cwd, isolate, keep, env, hidden, readable, user, scratch,
+                    outputs, fds)
+    finally:
+        _close_fds(fds)
+
+
+def _close_fds(fds):
+    """Closes the descriptors of the list `fds` and empties it."""
+    for fd in fds:
+        try:
+            os.close(fd)
+        except OSError:
+            pass
+    fds.clear()
+
+
+def _run(cmd, limits, writable, cwd, isolate, keep, env, hidden, readable, user, scratch, outputs, fds):
     if _stop.is_set():
         raise Stopped()
     writable = [os.path.abspath(d) for d in writable]
     hidden = [os.path.abspath(d) for d in hidden]
     readable = [os.path.abspath(d) for d in readable]
-    cwd = os.path.abspath(cwd or (writable[0] if writable else os.getcwd()))
+    scratch = scratch and os.path.abspath(scratch)
+    outputs = [os.path.abspath(f) for f in outputs]
+    cwd = os.path.abspath(cwd or scratch or (writable[0] if writable else os.getcwd()))
     output_bytes = int(limits.output_mb * (1 << 20))
-    full = list(cmd)
-    if isolate:
-        full = bwrap_prefix(writable or [cwd], cwd, output_bytes, hidden, readable) + ["--"] + full
-    if user is not None and not isolate:
-        if os.geteuid() != 0:
-            raise ValueError("sandbox: running commands as another user needs root")
-        _become_subreaper()
-        with _user_lock(user):
-            kill_user(user)  # nothing of that user runs beside the command
-            try:
-                result = _run_limited(full, limits, cwd, isolate, keep, env, output_bytes, None,
-                                      _user_tasks(user.uid) + limits.processes, user)
-            finally:
-                kill_user(user)
-                _reap_orphans(user)
-    else:
-        cgroup, nproc = _process_limit(limits)
-        try:
-            result = _run_limited(full, limits, cwd, isolate, keep, env, output_bytes, cgroup, nproc)
-        finally:
-            if cgroup:
-                _remove_cgroup(cgroup)
+    for f in outputs:
+        with open(f, "wb"):
+            pass
+    if user is not None and os.geteuid() != 0:
+        raise ValueError("sandbox: running commands as another user needs root")
+    if not isolate:
+        if user is not None:
+            return _run_as(user, list(cmd), limits, cwd, keep, env, output_bytes,
+                           writable + ([scratch] if scratch else []) + outputs, fds)
+        return _run_here(list(cmd), limits, cwd, False, keep, env, output_bytes, fds)
+    with box_user(user) as box:
+        full = bwrap_prefix(writable or ([] if scratch else [cwd]), cwd, output_bytes, hidden, readable,
+                            scratch, limits.disk_mb * (1 << 20), outputs, box) + ["--"]
+        full += (become(box) if box else []) + list(cmd)
+        with lent(writable + outputs if box else [], box):
+            return _run_here(full, limits, cwd, True, keep, env, output_bytes, fds)
+
+
+def _run_here(full, limits, cwd, isolate, keep, env, output_bytes, fds):
+    """As the grader's user (bubblewrap itself, as root, drops to the box user inside)."""
+    cgroup, nproc = _process_limit(limits)
+    try:
+        result = _run_limited(full, limits, cwd, isolate, keep, env, output_bytes, cgroup, nproc,
+                              pass_fds=fds)
+    finally:
+        if cgroup:
+            remove_cgroup(cgroup)
     if _stop.is_set():  # killed by stop_all: its result is not the command's
         raise Stopped()
     return result
 
 
-def _run_limited(full, limits, cwd, isolate, keep, env, output_bytes, cgroup, nproc, user=None):
+def _run_as(user, full, limits, cwd, keep, env, output_bytes, lend, fds):
+    """Without isolation, as root: as `user`, alone (every process of it is killed before
+    and after), under RLIMIT_NPROC."""
+    become_subreaper()
+    with user_lock(user), lent(lend, user):
+        kill_user(user)  # nothing of that user runs beside the command
+        try:
+            result = _run_limited(full, limits, cwd, False, keep, env, output_bytes, None,
+                                  user_tasks(user.uid) + limits.processes, user, fds)
+        finally:
+            kill_user(user)
+            reap_orphans(user)
+    if _stop.is_set():
+        raise Stopped()
+    return result
+
+
+def _run_limited(full, limits, cwd, isolate, keep, env, output_bytes, cgroup, nproc, user=None,
+                 pass_fds=None):
     started = time.monotonic()
     try:
         p = subprocess.Popen(full, cwd=cwd, stdin=subprocess.DEVNULL, stdout=subprocess.PIPE,
                              stderr=subprocess.PIPE, start_new_session=True, env=env,
-                             preexec_fn=_set_limits(limits, cgroup, nproc, user))
+                             preexec_fn=_set_limits(limits, cgroup, nproc, user),
+                             pass_fds=tuple(pass_fds or ()))
     except (OSError, subprocess.SubprocessError) as e:
         return Result("failed", f"failed: cannot start ({e})", 127, b"", str(e).encode(), 0.0)
+    finally:
+        if pass_fds:
+            _close_fds(pass_fds)  # the command's now (its peer sees the end when it ends)
     with _live_lock:
         _live.add(p)
     if _stop.is_set():  # stop_all ran between Popen and now
@@ -714,16 +465,17 @@ def main(argv):
         folder = args.dir
         os.makedirs(folder, exist_ok=True)
     else:  # kept for the outputs, so in the clone (build/), never in the shared /tmp
-        runs = os.path.join(os.path.dirname(os.path.dirname(os.path.dirname(os.path.abspath(__file__)))),
-                            "build", "sandbox")
+        runs = os.path.join(ROOT, "build", "sandbox")
         os.makedirs(runs, exist_ok=True)
         folder = tempfile.mkdtemp(prefix="run-", dir=runs)
         print(f"sandbox: the command's folder: {folder}", file=sys.stderr)
     if user:
         os.chown(folder, user.uid, user.gid)
+    # The command's own program, when it is a file of the caller's, is shown read-only.
+    program = shutil.which(cmd[0]) if os.sep not in cmd[0] else os.path.abspath(cmd[0])
     r = run(cmd, Limits(args.time, args.memory, args.output, processes=args.processes),
             writable=[folder], isolate=not args.no_isolation, keep=int(args.output * (1 << 20)),
-            user=user)
+            user=user, readable=[program] if program and os.path.isfile(program) else [])
     for name, data in (("stdout.txt", r.stdout), ("stderr.txt", r.stderr)):
         with open(os.path.join(folder, name), "wb") as f:
             f.write(data)

@@ -54,7 +54,8 @@ Vec3 viridis(double t) {
 }
 
 double scaleTop(double largest) {
-    if (!(largest < 1e300)) throw std::invalid_argument("scaleTop: the largest count is not finite");
+    if (!(largest < 1e300))
+        throw std::invalid_argument("scaleTop: the largest count is not finite");
     for (double decade = 1.0;; decade *= 10.0)
         for (double m : {1.0, 2.0, 5.0})
             if (m * decade >= largest) return m * decade;
@@ -68,8 +69,8 @@ int textWidth(const std::string& text, int scale) {
 void drawText(Image& image, int x, int y, const std::string& text, Vec3 colour, int scale) {
     std::string copy = text;
     std::vector<char> buffer(copy.size() * 1024 + 1024);  // 270 bytes a character on average
-    int quads = stb_easy_font_print(0.0f, 0.0f, copy.data(), nullptr, buffer.data(),
-                                    int(buffer.size()));
+    int quads =
+        stb_easy_font_print(0.0f, 0.0f, copy.data(), nullptr, buffer.data(), int(buffer.size()));
     // Each quad: four vertices of (x, y, z float, colour 4 bytes), an axis-aligned box.
     struct Vertex {
         float x, y, z;

@@ -57,9 +57,9 @@ struct RenderSettings {
     int threads = 0;          // 0: every hardware thread
     int samplesPerPixel = 1;  // > 1: stratified jitter within the pixel
     uint64_t seed = 1;
-    AnalysisParts analysis;        // which parts of the scene analysis skip shadow rays
-    bool forceAllEffects = false;  // trace every ray, zero weights too (naive renderer)
-    std::string progressLabel;     // when set, long renders print progress to stderr
+    AnalysisParts analysis;            // which parts of the scene analysis skip shadow rays
+    bool forceAllEffects = false;      // trace every ray, zero weights too (naive renderer)
+    std::string progressLabel;         // when set, long renders print progress to stderr
     RenderControl* control = nullptr;  // when set: progress per row, and a way to stop
 };
 

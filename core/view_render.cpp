@@ -28,11 +28,16 @@ void ViewRender::stop() {
     busy_ = false;
 }
 
+void ViewRender::finish() {
+    if (thread_.joinable()) thread_.join();
+}
+
 void ViewRender::run(RenderFn render, RenderSettings full) {
     // The passes: 1/8 and 1/2 of the size where that leaves at least a few pixels, then full.
     std::vector<std::pair<int, std::string>> passes;
     for (auto [divisor, name] : {std::pair{8, "1/8 size"}, std::pair{2, "1/2 size"}})
-        if (full.width / divisor >= 16 && full.height / divisor >= 12) passes.emplace_back(divisor, name);
+        if (full.width / divisor >= 16 && full.height / divisor >= 12)
+            passes.emplace_back(divisor, name);
     passes.emplace_back(1, "full size");
     try {
         for (const auto& [divisor, name] : passes) {

@@ -32,6 +32,8 @@ public:
     // Asks the render to stop and waits for it: a renderer that checks settings.control
     // stops within a row. The last finished pass stays available.
     void stop();
+    // Waits for the passes to end without stopping them (a scripted window's last frame).
+    void finish();
 
     // True while a pass is under way.
     bool busy() const;

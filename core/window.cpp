@@ -332,7 +332,8 @@ PanelArea drawPanel(const WindowOptions& options, const PanelPlacement& placemen
         lines.emplace_back(name.empty() ? "?" : name, binding.description);
     }
     lines.emplace_back("F1", "panel: fold to one line");
-    lines.emplace_back("F2", placement.beside ? "panel: over the picture" : "panel: beside the picture");
+    lines.emplace_back("F2",
+                       placement.beside ? "panel: over the picture" : "panel: beside the picture");
     lines.emplace_back("Esc/Q", "quit");
     float column = 0.0f;
     for (const auto& line : lines)

@@ -6,6 +6,7 @@
 #include "04_bvh/advanced/batch.hpp"
 #include "04_bvh/advanced/build.hpp"
 #include "04_bvh/advanced/rays.hpp"
+#include "04_bvh/cost_map.hpp"
 #include "04_bvh/culling_map.hpp"
 #include "core/timing.hpp"
 
@@ -241,7 +242,8 @@ void addTreeReport(Report& report, const Scene& scene, const MeshBvhGeometry& ge
 }
 
 void measureTree(Report& report, const Scene& scene, const MeshBvhGeometry& geometry,
-                 const CommonOptions& options, const MeasureSettings& settings) {
+                 const CommonOptions& options, const MeasureSettings& settings,
+                 const std::string& png) {
     MeasureSettings run = settings;
     run.seed = options.seed;
     run.dataDir = options.dataDir;
@@ -249,6 +251,8 @@ void measureTree(Report& report, const Scene& scene, const MeshBvhGeometry& geom
     // One build time per builder: the image's tree was built once; bvh_build gives each
     // builder's median of 5, which the page, the plot and the deck show.
     report.facts.erase("build_ms");
+    std::cerr << "04_bvh: the cost of a ray, per pixel...\n";
+    addCostMaps(report, scene, png, options.width, options.height, settings.bins, options.threads);
 }
 
 void addMeasureOptions(CLI::App& app, MeasureSettings& settings) {

@@ -51,9 +51,11 @@ void addMeasurements(Report& report, const NamedMesh& mesh, const Bvh& bvh,
 void addTreeReport(Report& report, const Scene& scene, const MeshBvhGeometry& geometry,
                    const std::string& png, const CommonOptions& options);
 // --measure: addMeasurements on the scene's mesh and the program's tree (seed and data
-// folder from `options`).
+// folder from `options`), and the heat maps of a ray's cost per builder beside `png`
+// (cost_map.hpp).
 void measureTree(Report& report, const Scene& scene, const MeshBvhGeometry& geometry,
-                 const CommonOptions& options, const MeasureSettings& settings);
+                 const CommonOptions& options, const MeasureSettings& settings,
+                 const std::string& png);
 // --measure-rays and --crack-rays into `settings`.
 void addMeasureOptions(CLI::App& app, MeasureSettings& settings);
 

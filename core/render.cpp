@@ -232,7 +232,10 @@ Vec3 Renderer::pixel(int x, int y, RayCounts& counts) const {
 
 void Renderer::renderRows(Image& image, int rowBegin, int rowEnd, RayCounts& counts) const {
     for (int y = rowBegin; y < rowEnd; ++y)
-        for (int x = 0; x < settings_.width; ++x) image.at(x, y) = pixel(x, y, counts);
+        for (int x = 0; x < settings_.width; ++x) {
+            checkCancelled(settings_.control);  // a slow row stops within a pixel
+            image.at(x, y) = pixel(x, y, counts);
+        }
 }
 
 void checkCancelled(const RenderControl* control) {

@@ -3,6 +3,7 @@
 // step with its own frame hook), with the step's keys and panel.
 #include <imgui.h>
 
+#include <algorithm>
 #include <sstream>
 
 #include "core/orbit.hpp"
@@ -44,7 +45,10 @@ int runStepWindow(const StepProgram& program, StepRun& run) {
     WindowCallbacks cb;
     cb.keys = program.keys;
     cb.onKey = [&](int key) {
-        if (!program.onKey) return false;
+        // Only the keys the step lists are its: Escape quits without waiting for the view.
+        bool listed = std::any_of(program.keys.begin(), program.keys.end(),
+                                  [&](const KeyBinding& k) { return k.key == key; });
+        if (!program.onKey || !listed) return false;
         stopView();
         bool used = program.onKey(run, key);
         target = run.settings;

@@ -68,6 +68,7 @@ std::runtime_error noWindow(const std::string& reason) {
     X(void, DeleteTextures, (GLsizei, const GLuint*))                               \
     X(void, DeleteVertexArrays, (GLsizei, const GLuint*))                           \
     X(void, Disable, (GLenum))                                                      \
+    X(void, Finish, ())                                                             \
     X(void, DrawArrays, (GLenum, GLint, GLsizei))                                   \
     X(void, GenTextures, (GLsizei, GLuint*))                                        \
     X(void, GenVertexArrays, (GLsizei, GLuint*))                                    \
@@ -436,9 +437,10 @@ void runWindow(const WindowOptions& options, WindowCallbacks& callbacks) {
     WindowLog log;
     SDL_Window* window = SDL_CreateWindow(
         options.title.c_str(), SDL_WINDOWPOS_CENTERED, SDL_WINDOWPOS_CENTERED, options.width,
-        options.height, SDL_WINDOW_OPENGL | SDL_WINDOW_RESIZABLE | SDL_WINDOW_ALLOW_HIGHDPI);
+        options.height,
+        // Hidden until its first frame is ready (below): a student never sees it black.
+        SDL_WINDOW_OPENGL | SDL_WINDOW_RESIZABLE | SDL_WINDOW_ALLOW_HIGHDPI | SDL_WINDOW_HIDDEN);
     if (!window) throw noWindow(std::string("SDL: ") + SDL_GetError());
-    log.start();
     Defer destroyWindow([window] { SDL_DestroyWindow(window); });
 
     SDL_GLContext context = SDL_GL_CreateContext(window);
@@ -467,6 +469,24 @@ void runWindow(const WindowOptions& options, WindowCallbacks& callbacks) {
     if (!ImGui_ImplOpenGL3_Init("#version 330 core"))
         throw noWindow("Dear ImGui's OpenGL 3 backend failed to initialise");
     Defer shutdownImGuiGl([] { ImGui_ImplOpenGL3_Shutdown(); });
+
+    // The first use of each shader and of the panel's font costs a lot (a software OpenGL
+    // compiles them then): done once while the window is hidden, so that once shown it
+    // draws its first frame at once.
+    {
+        PanelPlacement placement = options.panel;
+        ImGui_ImplOpenGL3_NewFrame();
+        ImGui_ImplSDL2_NewFrame();
+        ImGui::NewFrame();
+        Image warmUp(1, 1);
+        drawPanel(options, placement, callbacks, warmUp, 0.0);
+        ImGui::Render();
+        view.draw(warmUp, 0, 0, 1, 1);
+        ImGui_ImplOpenGL3_RenderDrawData(ImGui::GetDrawData());
+        gl.Finish();
+    }
+    SDL_ShowWindow(window);
+    log.start();
 
     // F1 and F2 place the panel; Escape and Q quit unless the step used the key (e.g. to
     // cancel something).

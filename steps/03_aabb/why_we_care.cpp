@@ -60,6 +60,7 @@ void renderCountingPixels(const Renderer& renderer, Image& image, PixelCosts& co
             RayCounts& counts = perThread[size_t(thread)];
             TestCounts::take();  // what this thread counted before belongs to no pixel
             for (int x = 0; x < w; ++x) {
+                checkCancelled(control);  // within a pixel: a row here can take long
                 uint64_t before = counts.total();
                 image.at(x, y) = renderer.pixel(x, y, counts);
                 TestCounts::OnThread tests = TestCounts::take();

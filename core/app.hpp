@@ -9,7 +9,6 @@
 #include <string>
 #include <vector>
 
-#include "core/camera.hpp"
 #include "core/render.hpp"
 #include "core/scene.hpp"
 

@@ -1,5 +1,6 @@
 // Triangle meshes read from Wavefront OBJ files (through tinyobjloader), exactly as given:
-// the file's own coordinates, triangles in file order, polygons fan-triangulated.
+// the file's own coordinates, triangles in file order, polygons fan-triangulated; and the
+// surface at a ray's hit on one of their triangles.
 #pragma once
 
 #include <array>
@@ -64,5 +65,25 @@ Mesh loadObj(const std::string& path);
 // limits: lower ones for tests.
 Mesh parseObj(const std::string& text, const std::string& name = "<memory>",
               const ObjLimits& limits = {});
+
+// ---- A hit on a mesh triangle --------------------------------------------------------------
+
+// A hit on a mesh triangle, filled the same way by every mesh geometry of the steps (the
+// idea of pbrt-v4's Triangle::InteractionFromIntersection): the geometric normal is the
+// unit normal of the winding, (b - a) x (c - a); the shading normal interpolates the
+// vertex normals with the barycentrics, (1 - u - v) na + u nb + v nc, normalized.
+
+// The surface at barycentrics (u, v) of one triangle, given as vertex indices into
+// positions and normals (the layout of Mesh): the point (1 - u - v) a + u b + v c, both
+// normals, u, v, and the kind. A zero-area triangle (hit only edge-on) gets the normal +y;
+// without vertex normals (normals not one per position), or where they cancel out, the
+// shading normal is the geometric one.
+SurfaceHit triangleSurface(const std::vector<Vec3>& positions, const std::vector<Vec3>& normals,
+                           const std::array<uint32_t, 3>& triangle, float u, float v);
+
+// A ray's hit at t on triangle `index` of `mesh`, with barycentrics (u, v): the surface as
+// above, the point on the ray, t, the material and the triangle's index as the primitive.
+SurfaceHit triangleHit(const Mesh& mesh, uint32_t index, const Ray& ray, float t, float u, float v,
+                       int material);
 
 }  // namespace boxes

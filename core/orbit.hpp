@@ -9,7 +9,7 @@
 #include <string>
 #include <vector>
 
-#include "core/camera.hpp"
+#include "core/scene.hpp"
 #include "core/window.hpp"
 
 namespace boxes {

@@ -1,7 +1,7 @@
 // A Whitted-style ray tracer: direct light with shadow rays, mirror reflection, glass
 // with Fresnel and total internal reflection, up to a maximum depth. It simulates only
 // the effects the scene calls for (the image is the same as with every effect traced) and
-// counts every ray it traces.
+// counts every ray it traces; and the threads it renders on.
 #pragma once
 
 #include <atomic>
@@ -107,7 +107,7 @@ Image renderImage(const Scene& scene, const Camera& camera, const RenderSettings
                   RayCounts* counts = nullptr);
 
 // Runs body(row) for every row on `threads` threads (0: all; the caller and kept workers,
-// see core/parallel.hpp), rows handed out one at a time; prints progress for long runs
+// see runOnThreads below), rows handed out one at a time; prints progress for long runs
 // when label is not empty. The first exception from body stops the rest and is rethrown.
 void parallelRows(int rows, int threads, const std::function<void(int row, int thread)>& body,
                   const std::string& label = "");
@@ -135,5 +135,26 @@ DirectLight directLight(const Material& material, const PointLight& light, const
 // Shadow and secondary rays start slightly off the surface, on the side they leave
 // towards, so they do not hit the surface they start on (self-intersection acne).
 Vec3 offsetOrigin(const Vec3& point, const Vec3& geometricNormal, const Vec3& direction);
+
+// ---- Threads -------------------------------------------------------------------------------
+
+// Work on several threads: the calling thread and worker threads kept from one call to the
+// next. Every step's renderer (parallelRows) and step 04's batch tracer run on it.
+//
+// Why kept workers, and why the caller works too: starting threads for every call costs
+// about as much as a short batch of rays takes, and a caller that only waits in join()
+// leaves a core idle; so the caller works beside workers that wait for the next call.
+
+// The thread count a `threads` setting means: 0 (or less) is every hardware thread.
+int resolveThreads(int threads);
+
+// Runs task(thread) once on each of `threads` threads (0: all), thread 0 being the caller;
+// returns when every one has returned. Workers take the caller's floating-point
+// environment (rounding mode, enabled traps) as threads started for the call would. The
+// first exception a task throws is rethrown here once all have returned; ending the other
+// tasks early is the task's own business (they share whatever counter hands out work).
+// A call made while the kept workers are busy (from another thread, or from inside a
+// task) starts threads of its own.
+void runOnThreads(int threads, const std::function<void(int thread)>& task);
 
 }  // namespace boxes

@@ -4,16 +4,24 @@
 #include <nlohmann/json.hpp>
 #include <ostream>
 #include <string>
+#include <utility>
 #include <variant>
 #include <vector>
-
-#include "core/timing.hpp"
 
 namespace boxes {
 
 using Cell = std::variant<std::string, double, long long>;
 
 struct Table {
+    Table() = default;
+    // A table's set-up in one statement: what it is, its columns, how it was measured.
+    Table(std::string id, std::string title, std::vector<std::string> columns,
+          std::string note = "")
+        : id(std::move(id)),
+          title(std::move(title)),
+          columns(std::move(columns)),
+          note(std::move(note)) {}
+
     std::string id;     // short key for scripts and the report, e.g. "triangle_speed"
     std::string title;  // one line for people
     std::vector<std::string> columns;

@@ -4,7 +4,7 @@
 #include <cmath>
 #include <optional>
 
-#include "core/shapes.hpp"
+#include "core/math.hpp"
 #include "exam/kinds.hpp"
 
 namespace boxes::exam::gen {

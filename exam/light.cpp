@@ -6,7 +6,6 @@
 #include <optional>
 
 #include "core/math.hpp"
-#include "core/shapes.hpp"
 #include "exam/kinds.hpp"
 
 namespace boxes::exam::gen {

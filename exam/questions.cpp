@@ -9,9 +9,8 @@
 #include <stdexcept>
 
 #include "core/bounds.hpp"
-#include "core/camera.hpp"
 #include "core/math.hpp"
-#include "core/shapes.hpp"
+#include "core/scene.hpp"
 #include "exam/answer.hpp"
 #include "exam/generate.hpp"
 #include "exam/kinds.hpp"

@@ -13,7 +13,6 @@
 #include "core/heatmap.hpp"
 #include "core/image.hpp"
 #include "core/mesh.hpp"
-#include "core/parallel.hpp"
 #include "core/render.hpp"
 #include "core/report.hpp"
 #include "core/scene.hpp"
@@ -158,10 +157,7 @@ TEST_SUITE("core") {
         CHECK(even.median == 1.25);  // (2 + 3) / 2 per repeat, 2 calls each
     }
     TEST_CASE("report: a table prints aligned text and JSON rows") {
-        Table t;
-        t.id = "x";
-        t.title = "T";
-        t.columns = {"name", "value"};
+        Table t("x", "T", {"name", "value"});
         t.row({std::string("a"), 1.5}).row({std::string("bb"), (long long)42});
         nlohmann::json j = t.toJson();
         CHECK(j["rows"].size() == 2);

@@ -2,9 +2,8 @@
 // against values worked out by hand.
 #include <cmath>
 
-#include "core/camera.hpp"
 #include "core/math.hpp"
-#include "core/shapes.hpp"
+#include "core/scene.hpp"
 #include "support.hpp"
 
 using namespace boxes;

@@ -2,10 +2,9 @@
 #include <cmath>
 #include <random>
 
-#include "core/camera.hpp"
-#include "core/ray.hpp"
+#include "core/math.hpp"
 #include "core/render.hpp"
-#include "core/shapes.hpp"
+#include "core/scene.hpp"
 #include "support.hpp"
 
 using namespace boxes;
@@ -51,7 +50,7 @@ TEST_SUITE("hard cases") {
     }
 }
 
-// Spheres and planes (core/shapes.hpp). Each case says which safeguard it guards.
+// Spheres and planes (core/math.hpp). Each case says which safeguard it guards.
 TEST_SUITE("hard cases") {
     TEST_CASE("hard case: a sphere or plane hit exactly at t == tmin counts (closed interval)") {
         // Unit sphere, ray from z = 5 down: the roots are exactly 4 (entry) and 6 (exit).

@@ -9,6 +9,26 @@
 using namespace boxes;
 using namespace boxes::test04;
 
+namespace {
+
+// traverseNearest along the ray from (0.2, 0.1, 10) down -z, the primitive in slot s hit at
+// t = tOfSlot(s); the slots it tests go to `calls`.
+template <typename TOfSlot>
+uint32_t nearestDown(const Bvh& bvh, float& tClosest, TOfSlot tOfSlot,
+                     std::vector<uint32_t>* calls = nullptr) {
+    Ray ray(Vec3(0.2f, 0.1f, 10.0f), Vec3(0, 0, -1));
+    tClosest = ray.tmax;
+    return traverseNearest(bvh, TraversalRay(ray), tClosest, [&](uint32_t s, float& tmax) {
+        if (calls) calls->push_back(s);
+        float t = tOfSlot(s);
+        if (t > tmax) return false;
+        tmax = t;
+        return true;
+    });
+}
+
+}  // namespace
+
 TEST_SUITE("exercise 4.4") {
     TEST_CASE("nearest hit equals brute force on a triangle soup") {
         Mesh m = triangleSoup(2000, 11);
@@ -34,16 +54,9 @@ TEST_SUITE("exercise 4.4") {
         bvh.nodes[2] = {Vec3(-1, -1, 9), 1, Vec3(1, 1, 9), 1};  // near leaf, slot 1
         bvh.primitiveIndices = {0, 1};
         std::vector<uint32_t> calls;
-        Ray ray(Vec3(0.2f, 0.1f, 10.0f), Vec3(0, 0, -1));
-        float tClosest = ray.tmax;
-        uint32_t slot =
-            traverseNearest(bvh, TraversalRay(ray), tClosest, [&](uint32_t s, float& tmax) {
-                calls.push_back(s);
-                float t = s == 1 ? 1.0f : 7.0f;  // the near leaf's primitive at z = 9
-                if (t > tmax) return false;
-                tmax = t;
-                return true;
-            });
+        float tClosest;  // the near leaf's primitive at z = 9
+        uint32_t slot = nearestDown(
+            bvh, tClosest, [](uint32_t s) { return s == 1 ? 1.0f : 7.0f; }, &calls);
         CHECK(slot == 1);
         CHECK(tClosest == 1.0f);
         CHECK(calls == std::vector<uint32_t>{1});
@@ -63,16 +76,9 @@ TEST_SUITE("exercise 4.4") {
         bvh.nodes[4] = {Vec3(-1, -1, 0), 2, Vec3(1, 1, 4), 1};     // B2, slot 2
         bvh.primitiveIndices = {0, 1, 2};
         std::vector<uint32_t> calls;
-        Ray ray(Vec3(0.2f, 0.1f, 10.0f), Vec3(0, 0, -1));
-        float tClosest = ray.tmax;
-        uint32_t slot =
-            traverseNearest(bvh, TraversalRay(ray), tClosest, [&](uint32_t s, float& tmax) {
-                calls.push_back(s);
-                float t = s == 0 ? 1.0f : 7.0f;
-                if (t > tmax) return false;
-                tmax = t;
-                return true;
-            });
+        float tClosest;
+        uint32_t slot = nearestDown(
+            bvh, tClosest, [](uint32_t s) { return s == 0 ? 1.0f : 7.0f; }, &calls);
         CHECK(slot == 0);
         CHECK(tClosest == 1.0f);
         CHECK(calls == std::vector<uint32_t>{0});
@@ -87,16 +93,9 @@ TEST_SUITE("exercise 4.4") {
         bvh.nodes[2] = {Vec3(-1, -1, 0), 1, Vec3(1, 1, 5), 1};  // far leaf, slot 1
         bvh.primitiveIndices = {0, 1};
         std::vector<uint32_t> calls;
-        Ray ray(Vec3(0.2f, 0.1f, 10.0f), Vec3(0, 0, -1));
-        float tClosest = ray.tmax;
-        uint32_t slot =
-            traverseNearest(bvh, TraversalRay(ray), tClosest, [&](uint32_t s, float& tmax) {
-                calls.push_back(s);
-                float t = s == 0 ? 1.0f : 7.0f;
-                if (t > tmax) return false;
-                tmax = t;
-                return true;
-            });
+        float tClosest;
+        uint32_t slot = nearestDown(
+            bvh, tClosest, [](uint32_t s) { return s == 0 ? 1.0f : 7.0f; }, &calls);
         CHECK(slot == 0);
         CHECK(calls == std::vector<uint32_t>{0});
     }
@@ -105,15 +104,8 @@ TEST_SUITE("exercise 4.4") {
         Bvh bvh;
         bvh.nodes = {{Vec3(-1, -1, 0), 0, Vec3(1, 1, 9), 2}};
         bvh.primitiveIndices = {0, 1};
-        Ray ray(Vec3(0.2f, 0.1f, 10.0f), Vec3(0, 0, -1));
-        float tClosest = ray.tmax;
-        uint32_t slot =
-            traverseNearest(bvh, TraversalRay(ray), tClosest, [&](uint32_t s, float& tmax) {
-                float t = s == 0 ? 5.0f : 2.0f;
-                if (t > tmax) return false;
-                tmax = t;
-                return true;
-            });
+        float tClosest;
+        uint32_t slot = nearestDown(bvh, tClosest, [](uint32_t s) { return s == 0 ? 5.0f : 2.0f; });
         CHECK(slot == 1);
         CHECK(tClosest == 2.0f);
     }

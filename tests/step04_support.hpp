@@ -243,8 +243,10 @@ inline size_t checkKeptInsideFrustum(const Mesh& m, const Frustum& f,
 
 // The tests' own reference builder: the full-sweep SAH (every primitive boundary on every
 // axis), not an exercise, so the traversal and culling tests pass with only their own
-// exercise solved. The engine has the same rule (advanced/build.hpp); the exercises' tests
-// must not need the engine.
+// exercise solved. The engine has the same rule (advanced/build.hpp); this is a copy, not a
+// call, because the grader takes everything under steps/ from the student's tree (a
+// reference there would be the student's to change) and the exercises' tests must not
+// need the engine.
 inline size_t referenceSweepSah(std::span<BuildPrimitive> prims, const Bounds3f& nodeBounds,
                                 const Bounds3f&, const BvhBuildOptions& options, float& cost) {
     cost = kInfinity<float>;

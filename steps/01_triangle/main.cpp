@@ -27,6 +27,8 @@ int main(int argc, char** argv) {
     TriangleTest test = TriangleTest::Watertight;
     std::shared_ptr<TriangleGrid> grid;  // the scene's mesh; none for a scene without one
 
+    // What the step is, for the shell (core/step.hpp): every main fills the same fields,
+    // then adds its own flags, tables and keys.
     StepProgram step;
     step.name = "01_triangle";
     step.description =

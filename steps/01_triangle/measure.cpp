@@ -123,11 +123,10 @@ template size_t countCracks<float>(const Mesh&, const std::vector<CrackRay>&, Tr
 template size_t countCracks<double>(const Mesh&, const std::vector<CrackRay>&, TriangleTest, Vec3);
 
 Table measureCracks(const std::vector<CrackCase>& cases, size_t raysPerFeature, uint64_t seed) {
-    Table table;
-    table.id = "cracks";
-    table.title =
-        "Cracks: rays aimed exactly at shared edges and vertices that no triangle there reports";
-    table.columns = {"mesh", "placement", "feature", "rays"};
+    Table table(
+        "cracks",
+        "Cracks: rays aimed exactly at shared edges and vertices that no triangle there reports",
+        {"mesh", "placement", "feature", "rays"});
     for (TriangleTest test : kAllTriangleTests)
         for (const char* p : {"float", "double"})
             table.columns.push_back(std::string(triangleTestName(test)) + " " + p + " /1M");
@@ -173,11 +172,9 @@ Table measureTriangleSpeed(const Mesh& mesh, uint64_t seed, int repeats) {
         rays.emplace_back(origin, target - origin);
         tris.push_back(tri);
     }
-    Table table;
-    table.id = "triangle_speed";
-    table.title = "Time per ray/triangle test (median of repeats over 4096 pairs, half hits)";
-    table.columns = {"test",   "precision", "ns/test",          "min ns",
-                     "max ns", "hits",      "answers differing"};
+    Table table("triangle_speed",
+                "Time per ray/triangle test (median of repeats over 4096 pairs, half hits)",
+                {"test", "precision", "ns/test", "min ns", "max ns", "hits", "answers differing"});
     table.note =
         "one thread; each sample times the whole batch of pairs; answers differing: pairs whose "
         "hit or miss differs from the watertight test in double";
@@ -221,15 +218,13 @@ Table measureTriangleSpeed(const Mesh& mesh, uint64_t seed, int repeats) {
 }
 
 Table accuracyVersusTime(const Table& speed, const Table& cracks) {
-    Table t;
-    t.id = "accuracy_vs_time";
-    t.title =
-        "Accuracy against time: each test's speed beside its cracks (all meshes and placements)";
-    t.columns = {"variant", "ns/test", "min ns", "max ns", "cracks /1M"};
-    t.note =
+    Table t(
+        "accuracy_vs_time",
+        "Accuracy against time: each test's speed beside its cracks (all meshes and placements)",
+        {"variant", "ns/test", "min ns", "max ns", "cracks /1M"},
         "ns/test (median, min, max) from the speed table; the error: cracks per million over "
         "every crack ray, against the geometry (every ray is aimed at a shared edge or vertex "
-        "of a closed mesh, so some triangle there must report it)";
+        "of a closed mesh, so some triangle there must report it)");
     t.timeAndError("ns/test", "min ns", "max ns", "cracks /1M");
     for (size_t i = 0; i < speed.rows.size(); ++i) {
         const auto& row = speed.rows[i];

@@ -3,8 +3,7 @@
 
 #include <optional>
 
-#include "core/ray.hpp"
-#include "core/shapes.hpp"
+#include "core/math.hpp"
 
 namespace boxes {
 

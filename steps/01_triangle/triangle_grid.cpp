@@ -3,7 +3,7 @@
 #include <algorithm>
 #include <cstdint>
 
-#include "core/triangle_hit.hpp"
+#include "core/mesh.hpp"
 
 namespace boxes {
 

@@ -6,8 +6,7 @@
 #include <optional>
 
 #include "core/bounds.hpp"
-#include "core/ray.hpp"
-#include "core/shapes.hpp"
+#include "core/math.hpp"
 
 namespace boxes {
 

@@ -17,6 +17,8 @@ int main(int argc, char** argv) {
     std::vector<SceneBox> boxList;
     std::shared_ptr<BoxSet> set;  // every box of the scene, through the selected method
 
+    // What the step is, for the shell (core/step.hpp): every main fills the same fields,
+    // then adds its own flags, tables and keys.
     StepProgram step;
     step.name = "02_box";
     step.description =

@@ -108,26 +108,22 @@ struct BoxVariant {
 }  // namespace
 
 std::vector<Table> measureBoxMethods(const BoxRaySet& set, int repeats) {
-    Table speed;
-    speed.id = "box_speed";
-    speed.title = "Time per ray/box test: the six-plane method against the slab method";
-    speed.columns = {"method", "precision", "ns/test",       "min ns",
-                     "max ns", "hits",      "wrong hit/miss"};
-    speed.note = "median of repeats over " + std::to_string(set.rays.size()) +
-                 " rays at random oriented boxes (faces, edges, near misses, from inside); the "
-                 "variants take turns in every repeat; one thread; six planes use precomputed "
-                 "planes (exercise 2.1); wrong hit/miss: against the slab method in long double";
+    Table speed(
+        "box_speed", "Time per ray/box test: the six-plane method against the slab method",
+        {"method", "precision", "ns/test", "min ns", "max ns", "hits", "wrong hit/miss"},
+        "median of repeats over " + std::to_string(set.rays.size()) +
+            " rays at random oriented boxes (faces, edges, near misses, from inside); the "
+            "variants take turns in every repeat; one thread; six planes use precomputed "
+            "planes (exercise 2.1); wrong hit/miss: against the slab method in long double");
     speed.timeAndError("ns/test", "min ns", "max ns", "wrong hit/miss");
-    Table accuracy;
-    accuracy.id = "box_accuracy";
-    accuracy.title =
-        "Accuracy against time: wrong answers of each method against a long double reference";
-    accuracy.columns = {"variant",        "ns/test",    "min ns",         "max ns",
-                        "wrong hit/miss", "wrong face", "max rel t error"};
-    accuracy.note =
+    Table accuracy(
+        "box_accuracy",
+        "Accuracy against time: wrong answers of each method against a long double reference",
+        {"variant", "ns/test", "min ns", "max ns", "wrong hit/miss", "wrong face",
+         "max rel t error"},
         "reference: the slab method in long double (64-bit mantissa) on the same "
         "float rays and boxes; a face counts as wrong only when the reference puts "
-        "that face's plane at another t (on an edge both faces are right); time as in box_speed";
+        "that face's plane at another t (on an edge both faces are right); time as in box_speed");
     accuracy.timeAndError("ns/test", "min ns", "max ns", "wrong hit/miss");
 
     std::vector<std::optional<BoxHit<Real>>> reference;
@@ -264,10 +260,8 @@ void measureBoxTests(const StepRun& run, BoxSet& set, size_t raysPerBox, Report&
         report.add(std::move(t));
     }
     Disagreement d = compareMethods(rays);
-    Table dis;
-    dis.id = "method_disagreement";
-    dis.title = "Where six planes and slabs disagree (both in float)";
-    dis.columns = {"rays", "count", "hit/miss differ", "face differs", "max rel t difference"};
+    Table dis("method_disagreement", "Where six planes and slabs disagree (both in float)",
+              {"rays", "count", "hit/miss differ", "face differs", "max rel t difference"});
     dis.note =
         "a face counts only when the t differ too (on an edge both faces are right); "
         "t compared where both hit";

@@ -8,9 +8,8 @@
 
 #include "01_triangle/triangle.hpp"  // TriangleT, as a data type only
 #include "core/bounds.hpp"
+#include "core/math.hpp"
 #include "core/mesh.hpp"
-#include "core/ray.hpp"
-#include "core/shapes.hpp"
 
 namespace boxes {
 

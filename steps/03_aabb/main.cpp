@@ -16,6 +16,8 @@ int main(int argc, char** argv) {
     int measureWidth = 64, measureHeight = 48;
     ManyObjects objects;  // the scene's objects, each with its boxes, and their test counts
 
+    // What the step is, for the shell (core/step.hpp): every main fills the same fields,
+    // then adds its own flags, tables and keys.
     StepProgram step;
     step.name = "03_aabb";
     step.description =

@@ -5,11 +5,12 @@
 #include <iostream>
 
 #include "core/heatmap.hpp"
-#include "core/parallel.hpp"
+#include "core/render.hpp"
 #include "core/timing.hpp"
 
 namespace boxes {
 
+// One case per value and no default: -Wswitch names a value added without its name.
 const char* slabVariantName(SlabVariant v) {
     switch (v) {
         case SlabVariant::Naive:
@@ -20,9 +21,10 @@ const char* slabVariantName(SlabVariant v) {
             return "1e30 stand-in for 1/0";
         case SlabVariant::Robust:
             return "robust (3.6)";
-        default:
+        case SlabVariant::Conservative:
             return "conservative (3.7)";
     }
+    return "?";
 }
 
 bool slabHit(SlabVariant v, const Ray& ray, const SlabRay& slabRay, const Bounds3f& box) {
@@ -41,11 +43,9 @@ bool slabHit(SlabVariant v, const Ray& ray, const SlabRay& slabRay, const Bounds
 }
 
 std::vector<Table> measureSlabTests(const std::vector<HardSlabRay>& rays, int repeats) {
-    Table accuracy;
-    accuracy.id = "slab_accuracy";
-    accuracy.title = "Accuracy against time: slab tests on hard rays against the exact answer";
-    accuracy.columns = {"variant",      "ns/test",    "min ns",   "max ns",
-                        "false misses", "false hits", "wrong /1M"};
+    Table accuracy(
+        "slab_accuracy", "Accuracy against time: slab tests on hard rays against the exact answer",
+        {"variant", "ns/test", "min ns", "max ns", "false misses", "false hits", "wrong /1M"});
     accuracy.note =
         std::to_string(rays.size()) +
         " hard rays (see slab_hard_rays); exact answers in 64-bit integers on a dyadic grid; "
@@ -54,10 +54,9 @@ std::vector<Table> measureSlabTests(const std::vector<HardSlabRay>& rays, int re
         "of " +
         std::to_string(repeats) + " repeats with the variants taking turns in each, one thread";
     accuracy.timeAndError("ns/test", "min ns", "max ns", "wrong /1M");
-    Table byCategory;
-    byCategory.id = "slab_hard_rays";
-    byCategory.title = "Wrong answers per kind of hard ray (false misses + false hits)";
-    byCategory.columns = {"rays", "count", "exact hits"};
+    Table byCategory("slab_hard_rays",
+                     "Wrong answers per kind of hard ray (false misses + false hits)",
+                     {"rays", "count", "exact hits"});
     for (SlabVariant v : kAllSlabVariants) byCategory.columns.push_back(slabVariantName(v));
     byCategory.note = "each ray is tested against the one box it was made for";
 

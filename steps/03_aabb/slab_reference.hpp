@@ -7,7 +7,7 @@
 #include <vector>
 
 #include "core/bounds.hpp"
-#include "core/ray.hpp"
+#include "core/math.hpp"
 
 namespace boxes {
 

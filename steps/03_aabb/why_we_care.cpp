@@ -8,8 +8,8 @@
 
 #include "01_triangle/triangle.hpp"
 #include "core/heatmap.hpp"
-#include "core/parallel.hpp"
-#include "core/triangle_hit.hpp"
+#include "core/mesh.hpp"
+#include "core/render.hpp"
 
 namespace boxes {
 

@@ -11,6 +11,7 @@
 
 namespace boxes {
 
+// One case per value and no default: -Wswitch names a value added without its name.
 const char* bvhBuilderName(BvhBuilder builder) {
     switch (builder) {
         case BvhBuilder::Midpoint:
@@ -21,9 +22,10 @@ const char* bvhBuilderName(BvhBuilder builder) {
             return "sah";
         case BvhBuilder::SweepSah:
             return "sweep-sah";
-        default:
+        case BvhBuilder::SpatialSah:
             return "sbvh";
     }
+    return "?";
 }
 
 BvhBuilder parseBvhBuilder(const std::string& name) {

@@ -18,10 +18,10 @@ namespace boxes {
 struct RayCost {
     uint32_t boxTests = 0, triangleTests = 0;
 };
-// The tests of one ray's nearest hit: the root's box before the ray's set-up (as trace.hpp's
-// entersRoot), then the reference traversal of exercise 4.4 (the root again, both children
-// of every inner node it enters, the triangles of every leaf), nearer child first and every
-// node beyond the nearest hit so far skipped.
+// The tests of one ray's nearest hit in the reference traversal of exercise 4.4 (trace.cpp's
+// nearestSlot): the root's box, both children of every inner node it enters, the triangles
+// of every leaf it enters, nearer child first and every node beyond the nearest hit so far
+// skipped.
 RayCost nearestHitCost(const Bvh& bvh, const Ray& ray);
 
 // The cost of each pixel's primary ray, rows top to bottom.

@@ -310,4 +310,12 @@ std::vector<std::string> CullingMapWindow::status() const {
     return lines;
 }
 
+void addTreeReport(Report& report, const Scene& scene, const MeshBvhGeometry& geometry,
+                   const std::string& png, const CommonOptions& options) {
+    report.facts["build_ms"] = geometry.stats().buildMs;
+    report.facts["nodes"] = geometry.stats().nodes;
+    report.facts["sah_cost"] = geometry.stats().sahCost;
+    addCullingMap(report, geometry.bvh(), png, options.width, options.height, scene.camera.up);
+}
+
 }  // namespace boxes

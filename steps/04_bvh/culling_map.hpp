@@ -8,6 +8,8 @@
 #include <vector>
 
 #include "04_bvh/frustum.hpp"
+#include "04_bvh/trace.hpp"
+#include "core/app.hpp"
 #include "core/image.hpp"
 #include "core/report.hpp"
 #include "core/window.hpp"
@@ -32,6 +34,10 @@ void drawCullingMap(Image& image, int x0, int width, const Bvh& bvh, const Frust
 // (suffix "-cull") and added to the report.
 void addCullingMap(Report& report, const Bvh& bvh, const std::string& png, int width, int height,
                    Vec3 up);
+// The headless report's part of the tree: its figures (build_ms, nodes, sah_cost) and the
+// culling map beside `png`.
+void addTreeReport(Report& report, const Scene& scene, const MeshBvhGeometry& geometry,
+                   const std::string& png, const CommonOptions& options);
 
 // The window's map: its keys (C, L, K, F), the counts of both tests for the current view,
 // and the panel's lines.

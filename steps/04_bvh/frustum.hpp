@@ -18,8 +18,8 @@
 
 #include "04_bvh/bvh.hpp"
 #include "core/bounds.hpp"
-#include "core/camera.hpp"
-#include "core/shapes.hpp"
+#include "core/math.hpp"
+#include "core/scene.hpp"
 
 namespace boxes {
 

@@ -1,6 +1,6 @@
 // Step 04: the leaf test, the watertight ray/triangle test (Woop, Benthin and Wald, JCGT
 // 2013) prepared once per ray. Not an exercise: the hierarchy's hits must not depend on
-// step 01's exercise 1.5 (a starter kit's is a stub), and its hot loop needs the per-ray
+// step 01's exercise 1.5 (a starter kit's is a stub), and its loop needs the per-ray
 // set-up below. tests/reliability.cpp checks it bit for bit against exercise 1.5's
 // solution, hard cases included; advanced/bench_leaf_test.cpp measures what the copy buys.
 #pragma once
@@ -11,7 +11,7 @@
 #include <utility>
 
 #include "04_bvh/bvh.hpp"
-#include "core/ray.hpp"
+#include "core/math.hpp"
 
 namespace boxes {
 
@@ -41,36 +41,12 @@ struct WatertightRay {
     }
 };
 
-// The six axis orders (kz the dominant axis, kx and ky swapped for a negative d[kz]),
-// as compile-time constants: the leaf test then reads components from registers instead
-// of through a run-time index (a store and an indexed load per component), and the
-// traversal is instantiated once per order, chosen once per ray (withWatertightAxes).
-template <int Kz, bool Swap>
-struct WatertightAxes {
-    static constexpr int kz = Kz;
-    static constexpr int kx = Swap ? (Kz + 2) % 3 : (Kz + 1) % 3;
-    static constexpr int ky = Swap ? (Kz + 1) % 3 : (Kz + 2) % 3;
+// The ray's axis order as the test reads it: here the ray's own (RayAxes, three integers);
+// the engine's loops fix it at compile time instead (advanced/traverse.hpp), with the
+// same arithmetic below.
+struct RayAxes {
+    int kx, ky, kz;
 };
-
-// Calls f(WatertightAxes<...>{}) with the ray's axis order.
-template <typename F>
-decltype(auto) withWatertightAxes(const WatertightRay& r, F&& f) {
-    bool swap = r.kx != (r.kz + 1) % 3;
-    switch (r.kz * 2 + int(swap)) {
-        case 0:
-            return f(WatertightAxes<0, false>{});
-        case 1:
-            return f(WatertightAxes<0, true>{});
-        case 2:
-            return f(WatertightAxes<1, false>{});
-        case 3:
-            return f(WatertightAxes<1, true>{});
-        case 4:
-            return f(WatertightAxes<2, false>{});
-        default:
-            return f(WatertightAxes<2, true>{});
-    }
-}
 
 // The same test in double, for the rare triangle whose float arithmetic leaves float's
 // range (see the callers below): exercise 1.5's fallback, operation for operation (its
@@ -78,10 +54,10 @@ decltype(auto) withWatertightAxes(const WatertightRay& r, F&& f) {
 // coordinates cannot overflow or underflow; a hit beyond float's range has no float t and
 // is a miss.
 template <typename Axes>
-[[gnu::noinline]] bool intersectLeafTriangleDouble(Axes, const WatertightRay& r,
+[[gnu::noinline]] bool intersectLeafTriangleDouble(Axes axes, const WatertightRay& r,
                                                    const LeafTriangle& tri, float& tmax,
                                                    float* uOut, float* vOut) {
-    constexpr int kx = Axes::kx, ky = Axes::ky, kz = Axes::kz;
+    const int kx = axes.kx, ky = axes.ky, kz = axes.kz;
     const glm::dvec3 d(r.direction), o(r.origin);
     const double sx = d[kx] / d[kz], sy = d[ky] / d[kz], sz = 1.0 / d[kz];
     const glm::dvec3 av = glm::dvec3(tri.a) - o, bv = glm::dvec3(tri.b) - o,
@@ -106,9 +82,9 @@ template <typename Axes>
 // A hit in [ray.tmin, tmax] lowers tmax to it; (u, v) are the barycentrics of b and c.
 // Axes must be the ray's order (r.kx, r.ky, r.kz); the arithmetic is exercise 1.5's.
 template <typename Axes>
-inline bool intersectLeafTriangle(Axes, const WatertightRay& r, const LeafTriangle& tri,
+inline bool intersectLeafTriangle(Axes axes, const WatertightRay& r, const LeafTriangle& tri,
                                   float& tmax, float* uOut = nullptr, float* vOut = nullptr) {
-    constexpr int kx = Axes::kx, ky = Axes::ky, kz = Axes::kz;
+    const int kx = axes.kx, ky = axes.ky, kz = axes.kz;
     const Vec3 av = tri.a - r.origin, bv = tri.b - r.origin, cv = tri.c - r.origin;
     const float *a = &av.x, *b = &bv.x, *c = &cv.x;
     float ax = a[kx] - r.sx * a[kz], ay = a[ky] - r.sy * a[kz];
@@ -125,7 +101,7 @@ inline bool intersectLeafTriangle(Axes, const WatertightRay& r, const LeafTriang
     }
     float det = u + v + w;  // not finite exactly when an edge function overflowed
     if (!std::isfinite(det)) [[unlikely]]
-        return intersectLeafTriangleDouble(Axes{}, r, tri, tmax, uOut, vOut);
+        return intersectLeafTriangleDouble(axes, r, tri, tmax, uOut, vOut);
     // Bitwise | and & on the comparisons: one branch, mostly taken (most tests miss),
     // instead of a chain of unpredictable ones.
     bool negative = (u < 0.0f) | (v < 0.0f) | (w < 0.0f);
@@ -139,7 +115,7 @@ inline bool intersectLeafTriangle(Axes, const WatertightRay& r, const LeafTriang
     float magnitude = std::fabs(tScaled);
     if (!(magnitude >= std::numeric_limits<float>::min() &&
           magnitude <= std::numeric_limits<float>::max())) [[unlikely]]
-        return intersectLeafTriangleDouble(Axes{}, r, tri, tmax, uOut, vOut);
+        return intersectLeafTriangleDouble(axes, r, tri, tmax, uOut, vOut);
     float t = tScaled / det;
     // A hit beyond the float range (t = +-inf) is a miss: HITS.bin has no t for it.
     if (!(t >= r.tmin && t <= tmax && std::fabs(t) <= std::numeric_limits<float>::max()))
@@ -150,11 +126,10 @@ inline bool intersectLeafTriangle(Axes, const WatertightRay& r, const LeafTriang
     return true;
 }
 
-// The same with the axis order chosen at run time (one switch per call: not for loops).
+// The test with the ray's own axis order: the one the chapter's loops call.
 inline bool intersectLeafTriangle(const WatertightRay& r, const LeafTriangle& tri, float& tmax,
                                   float* uOut = nullptr, float* vOut = nullptr) {
-    return withWatertightAxes(
-        r, [&](auto axes) { return intersectLeafTriangle(axes, r, tri, tmax, uOut, vOut); });
+    return intersectLeafTriangle(RayAxes{r.kx, r.ky, r.kz}, r, tri, tmax, uOut, vOut);
 }
 
 }  // namespace boxes

@@ -5,9 +5,10 @@
 #include <imgui.h>
 
 #include <algorithm>
+#include <functional>
 #include <memory>
+#include <optional>
 
-#include "04_bvh/advanced/commands.hpp"
 #include "04_bvh/cost_map.hpp"
 #include "04_bvh/culling_map.hpp"
 #include "04_bvh/measure.hpp"
@@ -19,10 +20,12 @@ using namespace boxes;
 int main(int argc, char** argv) {
     std::string builderName = "sah";
     MeasureSettings measure;
-    std::unique_ptr<EngineCommands> commands;  // trace and check, on the same command line
+    std::function<std::optional<int>()> engineCommand;  // trace, check, rays (measure.hpp)
     BvhBuildOptions build;
     std::shared_ptr<MeshBvhGeometry> geometry;  // the scene's mesh; none for a scene without one
 
+    // What the step is, for the shell (core/step.hpp): every main fills the same fields,
+    // then adds its own flags, tables and keys.
     StepProgram step;
     step.name = "04_bvh";
     step.description =
@@ -39,9 +42,9 @@ int main(int argc, char** argv) {
             ->check(CLI::Range(2, 256))
             ->capture_default_str();
         addMeasureOptions(app, measure);
-        commands = std::make_unique<EngineCommands>(app);
+        engineCommand = addEngineCommands(app);
     };
-    step.command = [&] { return commands->run(); };
+    step.command = [&] { return engineCommand(); };
     // The mesh through a hierarchy of the chapter's builders (trace.hpp).
     step.addGeometry = [&](StepRun& run) {
         build.builder = parseBvhBuilder(builderName);
@@ -58,7 +61,6 @@ int main(int argc, char** argv) {
     step.measure = [&](StepRun& run, Report& report) {
         if (geometry) measureTree(report, run.scene, *geometry, run.options, measure, run.png);
     };
-
     // The window: left the view through the hierarchy, right the hierarchy from above.
     CullingMapWindow map;
     bool heat = false;  // the view's tests per pixel instead of the picture and the map
@@ -70,15 +72,14 @@ int main(int argc, char** argv) {
         run.scene.camera.aspect = float(run.settings.width) / float(run.settings.height);
     };
     step.onKey = [&](StepRun& run, int key) {
-        if (key == SDLK_h) return heat = !heat, true;
+        if (key == SDLK_h) return heat = geometry && !heat, true;  // no mesh, no map
         if (key != SDLK_b || !geometry) return map.onKey(key);
         build.builder = BvhBuilder((int(build.builder) + 1) % std::size(kExerciseBuilders));
         geometry = addMeshBvh(run.scene, build);
         return true;
     };
     step.render = [&](StepRun& run) {
-        if (heat && geometry)
-            return viewCostMap(geometry->bvh(), run.camera, run.settings, build.builder);
+        if (heat) return viewCostMap(geometry->bvh(), run.camera, run.settings, build.builder);
         Image view = renderImage(run.scene, run.camera, run.settings);
         Image image(2 * run.settings.width, run.settings.height);
         for (int y = 0; y < view.height(); ++y)

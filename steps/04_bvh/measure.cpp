@@ -2,9 +2,12 @@
 
 #include <algorithm>
 #include <iostream>
+#include <memory>
 
 #include "04_bvh/advanced/batch.hpp"
 #include "04_bvh/advanced/build.hpp"
+#include "04_bvh/advanced/commands.hpp"
+#include "04_bvh/advanced/measure.hpp"
 #include "04_bvh/advanced/rays.hpp"
 #include "04_bvh/cost_map.hpp"
 #include "04_bvh/culling_map.hpp"
@@ -51,23 +54,21 @@ double busyLoopMops(int threads, int repeats) {
     return double(kIterations) * threads / t.median / 1e6;
 }
 
-}  // namespace
-
+// Per builder: build ms (median), nodes, leaves, leaf sizes, depth, SAH cost and its
+// excess over the full-sweep SAH tree. Table id "bvh_build".
 Table measureBuilds(const NamedMesh& mesh, int bins, int repeats) {
-    Table t;
-    t.id = "bvh_build";
-    t.title = "Builders on '" + mesh.name + "' (" + std::to_string(mesh.mesh->triangleCount()) +
-              " triangles): build time and tree quality";
-    t.columns = {"builder",    "build ms",  "ms/Mtri",  "nodes", "leaves",
-                 "leaf min",   "leaf mean", "leaf max", "depth", "SAH cost",
-                 "vs sweep %", "min ms",    "max ms"};
-    t.note = "median of " + std::to_string(repeats) +
-             " builds, one thread; SAH cost with "
-             "C_trav = C_isect = 1 relative to the root's area; 'vs sweep' is the excess over "
-             "the full-sweep SAH tree (every centroid a candidate plane); binned SAH with " +
-             std::to_string(bins) +
-             " bins (the sweep and the spatial splits: one build, so no spread); the error: the "
-             "SAH cost's excess over the full-sweep tree's";
+    Table t("bvh_build",
+            "Builders on '" + mesh.name + "' (" + std::to_string(mesh.mesh->triangleCount()) +
+                " triangles): build time and tree quality",
+            {"builder", "build ms", "ms/Mtri", "nodes", "leaves", "leaf min", "leaf mean",
+             "leaf max", "depth", "SAH cost", "vs sweep %", "min ms", "max ms"},
+            "median of " + std::to_string(repeats) +
+                " builds, one thread; SAH cost with "
+                "C_trav = C_isect = 1 relative to the root's area; 'vs sweep' is the excess over "
+                "the full-sweep SAH tree (every centroid a candidate plane); binned SAH with " +
+                std::to_string(bins) +
+                " bins (the sweep and the spatial splits: one build, so no spread); the error: the "
+                "SAH cost's excess over the full-sweep tree's");
     t.timeAndError("build ms", "min ms", "max ms", "vs sweep %");
     BvhBuildStats sweep;
     buildEngineBvh(*mesh.mesh, optionsFor(BvhBuilder::SweepSah, bins), &sweep);
@@ -91,17 +92,18 @@ Table measureBuilds(const NamedMesh& mesh, int bins, int repeats) {
     return t;
 }
 
+// Per builder and ray kind: Mrays/s on one thread (median of repeats), the tree's SAH cost
+// and the rays whose nearest hit differs from brute force on a sample (no build time: that
+// is bvh_build's). Table id "bvh_trace".
 Table measureTraceSpeed(const NamedMesh& mesh, size_t rays, size_t bruteForceRays, int repeats,
                         uint64_t seed, int bins) {
-    Table t;
-    t.id = "bvh_trace";
-    t.title = "Trace speed on '" + mesh.name + "', one thread, against brute force";
-    t.columns = {"builder", "rays",   "Mrays/s", "SAH cost", "hit %",
-                 "checked", "differ", "ns/ray",  "min ns",   "max ns"};
-    t.note = std::to_string(rays) + " rays per kind, median of " + std::to_string(repeats) +
-             " runs; 'differ': rays among the first " + std::to_string(bruteForceRays) +
-             " whose nearest hit is neither the brute-force triangle nor at its t; ns/ray: "
-             "median, min and max of the runs";
+    Table t("bvh_trace", "Trace speed on '" + mesh.name + "', one thread, against brute force",
+            {"builder", "rays", "Mrays/s", "SAH cost", "hit %", "checked", "differ", "ns/ray",
+             "min ns", "max ns"},
+            std::to_string(rays) + " rays per kind, median of " + std::to_string(repeats) +
+                " runs; 'differ': rays among the first " + std::to_string(bruteForceRays) +
+                " whose nearest hit is neither the brute-force triangle nor at its t; ns/ray: "
+                "median, min and max of the runs");
     t.timeAndError("ns/ray", "min ns", "max ns", "differ");
     std::vector<std::vector<Ray>> sets;
     std::vector<std::vector<TraceHit>> reference;
@@ -134,15 +136,14 @@ Table measureTraceSpeed(const NamedMesh& mesh, size_t rays, size_t bruteForceRay
     return t;
 }
 
+// 1 thread against 2 (binned SAH, primary and diffuse rays). Table id "bvh_threads".
 Table measureThreads(const NamedMesh& mesh, size_t rays, int repeats, uint64_t seed) {
-    Table t;
-    t.id = "bvh_threads";
-    t.title = "Threads: binned SAH on '" + mesh.name + "', 1 thread against 2";
-    t.columns = {"rays", "1 thread Mrays/s", "2 threads Mrays/s", "speed-up"};
-    t.note = "rays handed out in chunks of 1024 through an atomic counter; median of " +
-             std::to_string(repeats) +
-             " runs; 'control': a loop that touches no memory, split the same way (millions of "
-             "iterations per second): the speed-up two threads can have on this machine now";
+    Table t("bvh_threads", "Threads: binned SAH on '" + mesh.name + "', 1 thread against 2",
+            {"rays", "1 thread Mrays/s", "2 threads Mrays/s", "speed-up"},
+            "rays handed out in chunks of 1024 through an atomic counter; median of " +
+                std::to_string(repeats) +
+                " runs; 'control': a loop that touches no memory, split the same way (millions of "
+                "iterations per second): the speed-up two threads can have on this machine now");
     Bvh bvh = buildEngineBvh(*mesh.mesh, optionsFor(BvhBuilder::BinnedSah, 16));
     for (RayKind kind : {RayKind::Primary, RayKind::Diffuse}) {
         std::vector<Ray> set = makeRays(*mesh.mesh, kind, rays, seed);
@@ -154,12 +155,14 @@ Table measureThreads(const NamedMesh& mesh, size_t rays, int repeats, uint64_t s
     return t;
 }
 
+// Build time (bvh_build's median) and trace speed per builder (primary rays) beside the rays
+// it loses against brute force and its cracks, from measureBuilds's, measureTraceSpeed's and
+// measureBvhCracks's tables. Table id "bvh_tradeoff".
 Table measureTradeoff(const Table& builds, const Table& traceSpeed, const Table& cracks) {
-    Table t;
-    t.id = "bvh_tradeoff";
-    t.title = "Build time, trace speed and rays lost per builder (primary rays, one thread)";
-    t.columns = {"builder", "build ms",  "Mrays/s", "ns/ray",       "min ns",
-                 "max ns",  "rays lost", "cracks",  "lost + cracks"};
+    Table t("bvh_tradeoff",
+            "Build time, trace speed and rays lost per builder (primary rays, one thread)",
+            {"builder", "build ms", "Mrays/s", "ns/ray", "min ns", "max ns", "rays lost", "cracks",
+             "lost + cracks"});
     t.note =
         "build ms: the median of bvh_build's builds (the same number as there); time: a "
         "primary ray's (bvh_trace); rays lost: rays of every kind whose nearest hit "
@@ -197,6 +200,37 @@ Table measureTradeoff(const Table& builds, const Table& traceSpeed, const Table&
     return t;
 }
 
+// Culled / kept / wrongly kept nodes for both tests from cameras around the mesh, close
+// enough that the frustum cuts it. Table id "bvh_culling".
+Table measureCulling(const NamedMesh& mesh, const Bvh& bvh, int cameras) {
+    Table t("bvh_culling",
+            "Frustum culling of the hierarchy on '" + mesh.name + "' (binned SAH tree)",
+            {"view", "test", "visited", "culled", "kept", "wrongly kept", "kept triangles", "ms",
+             "min ms", "max ms"});
+    t.note =
+        "views around the mesh, fov 40, far plane through the mesh's centre; 'wrongly "
+        "kept': kept boxes that lie entirely outside the frustum (exact separating-axis "
+        "test, the reference); 'ms': culling traversal without the exact classification, median "
+        "of 5 (min, max)";
+    t.timeAndError("ms", "min ms", "max ms", "wrongly kept");
+    for (int i = 0; i < cameras; ++i) {
+        CullingView v = cullingView(bvh.bounds(), i, cameras, 4.0f / 3.0f);
+        Frustum f = makeFrustum(v.camera, v.nearDistance, v.farDistance);
+        for (CullTest test : {CullTest::Planes, CullTest::PlanesAndCorners}) {
+            CullCounts c;
+            cullHierarchy(bvh, f, test, &c);
+            Timing time = measure(5, [&] { cullHierarchy(bvh, f, test); });
+            t.row({(long long)i, std::string(test == CullTest::Planes ? "planes" : "+ corners"),
+                   (long long)c.visited, (long long)c.culled, (long long)c.kept,
+                   (long long)c.wronglyKept, (long long)c.keptTriangles, time.median * 1e3,
+                   time.min * 1e3, time.max * 1e3});
+        }
+    }
+    return t;
+}
+
+// The whole `--measure` run on the scene's mesh and `bvh` (the program's tree), with the
+// crack count on the bunny and sh1 from dataDir, and the trade-off's plot.
 void addMeasurements(Report& report, const NamedMesh& mesh, const Bvh& bvh,
                      const MeasureSettings& settings) {
     std::cerr << "04_bvh: measuring builds...\n";
@@ -233,13 +267,7 @@ void addMeasurements(Report& report, const NamedMesh& mesh, const Bvh& bvh,
                              "primary ray, with the Pareto front"}});
 }
 
-void addTreeReport(Report& report, const Scene& scene, const MeshBvhGeometry& geometry,
-                   const std::string& png, const CommonOptions& options) {
-    report.facts["build_ms"] = geometry.stats().buildMs;
-    report.facts["nodes"] = geometry.stats().nodes;
-    report.facts["sah_cost"] = geometry.stats().sahCost;
-    addCullingMap(report, geometry.bvh(), png, options.width, options.height, scene.camera.up);
-}
+}  // namespace
 
 void measureTree(Report& report, const Scene& scene, const MeshBvhGeometry& geometry,
                  const CommonOptions& options, const MeasureSettings& settings,
@@ -263,32 +291,9 @@ void addMeasureOptions(CLI::App& app, MeasureSettings& settings) {
         ->check(CLI::Range(size_t(1), size_t(10000000)));
 }
 
-Table measureCulling(const NamedMesh& mesh, const Bvh& bvh, int cameras) {
-    Table t;
-    t.id = "bvh_culling";
-    t.title = "Frustum culling of the hierarchy on '" + mesh.name + "' (binned SAH tree)";
-    t.columns = {"view",         "test",           "visited", "culled", "kept",
-                 "wrongly kept", "kept triangles", "ms",      "min ms", "max ms"};
-    t.note =
-        "views around the mesh, fov 40, far plane through the mesh's centre; 'wrongly "
-        "kept': kept boxes that lie entirely outside the frustum (exact separating-axis "
-        "test, the reference); 'ms': culling traversal without the exact classification, median "
-        "of 5 (min, max)";
-    t.timeAndError("ms", "min ms", "max ms", "wrongly kept");
-    for (int i = 0; i < cameras; ++i) {
-        CullingView v = cullingView(bvh.bounds(), i, cameras, 4.0f / 3.0f);
-        Frustum f = makeFrustum(v.camera, v.nearDistance, v.farDistance);
-        for (CullTest test : {CullTest::Planes, CullTest::PlanesAndCorners}) {
-            CullCounts c;
-            cullHierarchy(bvh, f, test, &c);
-            Timing time = measure(5, [&] { cullHierarchy(bvh, f, test); });
-            t.row({(long long)i, std::string(test == CullTest::Planes ? "planes" : "+ corners"),
-                   (long long)c.visited, (long long)c.culled, (long long)c.kept,
-                   (long long)c.wronglyKept, (long long)c.keptTriangles, time.median * 1e3,
-                   time.min * 1e3, time.max * 1e3});
-        }
-    }
-    return t;
+std::function<std::optional<int>()> addEngineCommands(CLI::App& app) {
+    auto commands = std::make_shared<EngineCommands>(app);
+    return [commands] { return commands->run(); };
 }
 
 }  // namespace boxes

@@ -2,26 +2,48 @@
 
 #include <utility>
 
-#include "core/triangle_hit.hpp"
+#include "core/mesh.hpp"
 
 namespace boxes {
+
+uint32_t nearestSlot(const Bvh& bvh, const Ray& ray, float& tClosest, float* u, float* v) {
+    tClosest = ray.tmax;
+    TraversalRay boxes(ray, bvh);  // for the box tests, with the tree's margin
+    WatertightRay triangles(ray);  // the triangle test's set-up, once per ray
+    return traverseNearest(bvh, boxes, tClosest, [&](uint32_t slot, float& tmax) {
+        return intersectLeafTriangle(triangles, bvh.leafTriangles[slot], tmax, u, v);
+    });
+}
+
+TraceHit traceNearest(const Bvh& bvh, const Ray& ray) {
+    float tClosest;
+    uint32_t slot = nearestSlot(bvh, ray, tClosest);
+    if (slot == kTraversalMiss) return {};
+    return {tClosest, bvh.primitiveIndices[slot]};
+}
+
+bool traceOccluded(const Bvh& bvh, const Ray& ray) {
+    TraversalRay boxes(ray, bvh);
+    WatertightRay triangles(ray);
+    return traverseAny(bvh, boxes, [&](uint32_t slot, float tmax) {
+        return intersectLeafTriangle(triangles, bvh.leafTriangles[slot], tmax);
+    });
+}
 
 TraceHit traceBruteForce(const Mesh& mesh, const Ray& ray) {
     WatertightRay watertight(ray);
     TraceHit best;
     float tClosest = ray.tmax;
-    withWatertightAxes(watertight, [&](auto axes) {
-        for (size_t i = 0; i < mesh.triangles.size(); ++i) {
-            LeafTriangle tri = leafTriangleOf(mesh, i);
-            float t = tClosest;
-            // Strictly nearer only: the first of equally near triangles stays.
-            if (intersectLeafTriangle(axes, watertight, tri, t) &&
-                (best.triangle == kNoPrimitive || t < tClosest)) {
-                tClosest = t;
-                best = {t, uint32_t(i)};
-            }
+    for (size_t i = 0; i < mesh.triangles.size(); ++i) {
+        LeafTriangle tri = leafTriangleOf(mesh, i);
+        float t = tClosest;
+        // Strictly nearer only: the first of equally near triangles stays.
+        if (intersectLeafTriangle(watertight, tri, t) &&
+            (best.triangle == kNoPrimitive || t < tClosest)) {
+            tClosest = t;
+            best = {t, uint32_t(i)};
         }
-    });
+    }
     return best;
 }
 

@@ -1,7 +1,8 @@
 // Step 04: traversing the hierarchy. A ray prepared for box tests, the test of one node's
 // box, and the two traversals: exercise 4.4 (nearest hit) and 4.5 (any hit). Both are
 // templates over the primitive test, so the same loop serves the watertight triangle test
-// (trace.hpp), a test's reference triangle test, and anything else with bounds.
+// (trace.cpp), a test's reference triangle test, and anything else with bounds. The
+// engine's fast copy of these loops is advanced/traverse.hpp.
 #pragma once
 
 #include <cmath>
@@ -10,7 +11,7 @@
 #include <utility>
 
 #include "04_bvh/bvh.hpp"
-#include "core/ray.hpp"
+#include "core/math.hpp"
 
 namespace boxes {
 
@@ -108,23 +109,6 @@ struct TraversalRay {
 // Depth of the traversal stack: the builders cap the depth below it.
 constexpr int kTraversalStackSize = 2 * kMaxBvhDepth;
 
-// A hint for the traversal: ask for what it will read after `node` (its children's pair
-// of boxes, or its leaf's triangles) while it still tests the current pair. Incoherent
-// rays spend most of their time waiting for memory, and the fetch then overlaps the work.
-// Only a hint: a traversal is correct without it (try yours with and without, in time).
-// Always inlined: GCC finds that a call to it has no effect and drops the call, hints and
-// all, once it is too large to be inlined early (a version with two more hints lost them).
-[[gnu::always_inline]] inline void prefetchNodeContents(const Bvh& bvh, const BvhNode& node) {
-    if (!node.isLeaf())
-        __builtin_prefetch(&bvh.nodes[node.leftFirst]);
-    else if (!bvh.leafTriangles.empty()) {
-        // A leaf's triangles (36 bytes each) span two cache lines from its second one on.
-        const char* first = reinterpret_cast<const char*>(&bvh.leafTriangles[node.leftFirst]);
-        __builtin_prefetch(first);
-        if (node.count > 1) __builtin_prefetch(first + 64);
-    }
-}
-
 // EXERCISE 4.4: nearest-hit traversal: nearer child first, early out (4 points)
 // intersect(slot, tClosest) tests the primitive in leaf slot `slot` for a hit in
 // [ray.tmin, tClosest], and on a hit lowers tClosest and returns true. Returns the slot of
@@ -137,11 +121,6 @@ uint32_t traverseNearest(const Bvh& bvh, const TraversalRay& ray, float& tCloses
     // BEGIN SOLUTION
     if (bvh.nodes.empty()) return kTraversalMiss;
     uint32_t nearestSlot = kTraversalMiss;
-    const BvhNode* nodes = bvh.nodes.data();
-    // Local copies: the compiler may then keep them in registers across intersect(),
-    // which it must otherwise assume writes to them.
-    const TraversalRay r = ray;
-    float tBest = tClosest;
     // The stack keeps where the ray enters each postponed node: a pop skips it without a
     // second box test once a hit nearer than that is known.
     struct Entry {
@@ -150,21 +129,19 @@ uint32_t traverseNearest(const Bvh& bvh, const TraversalRay& ray, float& tCloses
     } stack[kTraversalStackSize];
     int stackSize = 0;
     float tRoot;
-    if (!intersectNodeBounds(nodes[0], r, tBest, tRoot)) return kTraversalMiss;
+    if (!intersectNodeBounds(bvh.nodes[0], ray, tClosest, tRoot)) return kTraversalMiss;
     uint32_t current = 0;
     for (;;) {
-        const BvhNode& node = nodes[current];
+        const BvhNode& node = bvh.nodes[current];
         if (node.isLeaf()) {
             for (uint32_t slot = node.leftFirst; slot < node.leftFirst + node.count; ++slot)
-                if (intersect(slot, tBest)) nearestSlot = slot;
+                if (intersect(slot, tClosest)) nearestSlot = slot;
         } else {
             // Both children at once: descend into the nearer, keep the farther for later.
             uint32_t near = node.leftFirst, far = node.leftFirst + 1;
-            prefetchNodeContents(bvh, nodes[near]);
-            prefetchNodeContents(bvh, nodes[far]);
             float tNear, tFar;
-            bool hitNear = intersectNodeBounds(nodes[near], r, tBest, tNear);
-            bool hitFar = intersectNodeBounds(nodes[far], r, tBest, tFar);
+            bool hitNear = intersectNodeBounds(bvh.nodes[near], ray, tClosest, tNear);
+            bool hitFar = intersectNodeBounds(bvh.nodes[far], ray, tClosest, tFar);
             if (hitNear && hitFar) {
                 if (tFar < tNear) {
                     std::swap(near, far);
@@ -183,7 +160,7 @@ uint32_t traverseNearest(const Bvh& bvh, const TraversalRay& ray, float& tCloses
         bool found = false;
         while (stackSize > 0) {
             const Entry& e = stack[--stackSize];
-            if (e.tEntry <= tBest) {
+            if (e.tEntry <= tClosest) {
                 current = e.node;
                 found = true;
                 break;
@@ -191,7 +168,6 @@ uint32_t traverseNearest(const Bvh& bvh, const TraversalRay& ray, float& tCloses
         }
         if (!found) break;
     }
-    tClosest = tBest;
     return nearestSlot;
     // END SOLUTION
 }

@@ -3,7 +3,7 @@
 #include <algorithm>
 
 #include "04_bvh/advanced/build.hpp"
-#include "core/triangle_hit.hpp"
+#include "core/mesh.hpp"
 
 namespace boxes {
 

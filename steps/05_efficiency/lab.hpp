@@ -11,7 +11,7 @@
 
 #include "core/bounds.hpp"
 #include "core/exercise.hpp"
-#include "core/ray.hpp"
+#include "core/math.hpp"
 #include "core/scene.hpp"
 
 namespace boxes {

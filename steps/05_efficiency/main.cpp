@@ -17,6 +17,8 @@ int main(int argc, char** argv) {
     std::shared_ptr<LabBvhMesh> mesh;  // the scene's mesh, if any
     std::unique_ptr<ProgressiveViewer> viewer;
 
+    // What the step is, for the shell (core/step.hpp): every main fills the same fields,
+    // then adds its own flags, tables and keys.
     StepProgram step;
     step.name = "05_efficiency";
     step.description =

@@ -111,6 +111,7 @@ void measureLab(const Scene& scene, LabBvhMesh* mesh, const LabOptions& o, Repor
 namespace {
 
 // The preview's file name suffix, e.g. "depth-material".
+// One case per value and no default: -Wswitch names a value added without its name.
 std::string slug(PreviewMode m) {
     switch (m) {
         case PreviewMode::Depth:
@@ -125,9 +126,10 @@ std::string slug(PreviewMode m) {
             return "half-resolution";
         case PreviewMode::Adaptive:
             return "adaptive";
-        default:
+        case PreviewMode::Full:
             return "full";
     }
+    return "?";
 }
 
 }  // namespace

@@ -11,6 +11,7 @@
 #include "core/report.hpp"
 #include "core/scene.hpp"
 #include "core/step.hpp"
+#include "core/timing.hpp"
 
 namespace boxes {
 

@@ -68,6 +68,7 @@ void AdaptiveResolution::update(double frameSeconds) {
     // END SOLUTION
 }
 
+// One case per value and no default: -Wswitch names a value added without its name.
 const char* previewModeName(PreviewMode mode) {
     switch (mode) {
         case PreviewMode::Depth:
@@ -82,9 +83,10 @@ const char* previewModeName(PreviewMode mode) {
             return "half resolution";
         case PreviewMode::Adaptive:
             return "adaptive resolution";
-        default:
+        case PreviewMode::Full:
             return "full";
     }
+    return "?";
 }
 
 Image enlargeNearest(const Image& small, int width, int height) {

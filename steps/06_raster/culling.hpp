@@ -11,8 +11,8 @@
 #include "04_bvh/bvh.hpp"
 #include "04_bvh/frustum.hpp"
 #include "06_raster/pipeline.hpp"
-#include "core/camera.hpp"
 #include "core/mesh.hpp"
+#include "core/scene.hpp"
 
 namespace boxes {
 

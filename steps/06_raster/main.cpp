@@ -20,6 +20,8 @@ int main(int argc, char** argv) {
     RasterFrame frame;
     std::unique_ptr<RasterViewer> viewer;
 
+    // What the step is, for the shell (core/step.hpp): every main fills the same fields,
+    // then adds its own flags, tables and keys.
     StepProgram step;
     step.name = "06_raster";
     step.description =

@@ -57,20 +57,23 @@ std::string findInteriorMap(const std::string& folder, std::string* why) {
                              ": no oa_thor.obj in that folder");
         return fs::weakly_canonical(obj, ec).string();
     }
-    const fs::path cache = BOXES_MESH_CACHE, tool = BOXES_MESH_TOOL;
+    const fs::path cache = BOXES_MESH_CACHE, tool = BOXES_MESH_TOOL, root = BOXES_SOURCE_ROOT;
     const fs::path obj = cache / "oa_thor.obj";
     // meshes.py checks the cached file's provenance against the package's version and
     // converts the map when it is missing or stale (about 2 s); exit code 3: no package.
-    if (fs::exists(tool, ec) && (tool.string() + cache.string()).find('\'') == std::string::npos) {
-        std::string command = "python3 '" + tool.string() + "' oa_thor --cache '" + cache.string() +
-                              "' >/dev/null 2>&1";
+    // It belongs to the tools package, so it runs as a module from the clone's root.
+    if (fs::exists(tool, ec) && (root.string() + cache.string()).find('\'') == std::string::npos) {
+        std::string command = "cd '" + root.string() +
+                              "' && python3 -m tools.bench.meshes oa_thor --cache '" +
+                              cache.string() + "' >/dev/null 2>&1";
         int rc = std::system(command.c_str());
         if (rc == 0 && fs::exists(obj, ec)) return obj.string();
         if (why)
             *why =
                 "the interior map cannot be made (Debian's openarena-088-data: "
-                "tools/deps.sh bench installs it; then " +
-                tool.string() + " oa_thor makes " + obj.string() + ")";
+                "tools/deps.sh bench installs it; then python3 -m tools.bench.meshes oa_thor "
+                "in " +
+                root.string() + " makes " + obj.string() + ")";
         return "";
     }
     if (fs::exists(obj, ec)) return obj.string();
@@ -103,22 +106,14 @@ std::vector<MeasureView> measureViews(const std::string& dataDir, const std::str
 }
 
 Table measureVisibility(const std::vector<MeasureView>& views, const MeasureSettings& m) {
-    Table t;
-    t.id = "visibility";
-    t.title = "Primary visibility: the rasterizer against the ray tracer, pixel for pixel";
-    t.columns = {"view",
-                 "triangles",
-                 "covered raster",
-                 "covered traced",
-                 "same triangle %",
-                 "differ on edges",
-                 "differ elsewhere",
-                 "coverage diff % of image",
-                 "max depth error"};
-    t.note = std::to_string(m.width) + "x" + std::to_string(m.height) +
-             "; same triangle: share of pixels covered by either where both name the same mesh "
-             "triangle; 'on edges': the other's triangle is seen within one pixel; depth error "
-             "relative, where they agree";
+    Table t("visibility",
+            "Primary visibility: the rasterizer against the ray tracer, pixel for pixel",
+            {"view", "triangles", "covered raster", "covered traced", "same triangle %",
+             "differ on edges", "differ elsewhere", "coverage diff % of image", "max depth error"},
+            std::to_string(m.width) + "x" + std::to_string(m.height) +
+                "; same triangle: share of pixels covered by either where both name the same mesh "
+                "triangle; 'on edges': the other's triangle is seen within one pixel; depth error "
+                "relative, where they agree");
     for (const MeasureView& v : views) {
         std::cerr << "06_raster: visibility on " << v.name << "...\n";
         RasterScene raster = RasterScene::fromScene(v.scene);
@@ -136,23 +131,16 @@ Table measureVisibility(const std::vector<MeasureView>& views, const MeasureSett
 }
 
 Table measureFrameTimes(const std::vector<MeasureView>& views, const MeasureSettings& m) {
-    Table t;
-    t.id = "frame_time";
-    t.title = "Time per frame, single thread: rasterizer against ray tracer (ms, median)";
-    t.columns = {"view",
-                 "triangles",
-                 "raster visibility",
-                 "raster shaded",
-                 "raster + shadow map",
-                 "raster + shadow rays",
-                 "traced visibility",
-                 "traced shaded (Whitted)",
-                 "visibility speed-up"};
-    t.note = std::to_string(m.width) + "x" + std::to_string(m.height) + ", median of " +
-             std::to_string(m.repeats) +
-             " frames; raster shaded: deferred shading of the z-buffer without shadows; the shadow "
-             "map is rebuilt every frame (" +
-             std::to_string(m.mapSize()) + "^2); the ray tracer uses step 01's uniform grid";
+    Table t(
+        "frame_time", "Time per frame, single thread: rasterizer against ray tracer (ms, median)",
+        {"view", "triangles", "raster visibility", "raster shaded", "raster + shadow map",
+         "raster + shadow rays", "traced visibility", "traced shaded (Whitted)",
+         "visibility speed-up"},
+        std::to_string(m.width) + "x" + std::to_string(m.height) + ", median of " +
+            std::to_string(m.repeats) +
+            " frames; raster shaded: deferred shading of the z-buffer without shadows; the shadow "
+            "map is rebuilt every frame (" +
+            std::to_string(m.mapSize()) + "^2); the ray tracer uses step 01's uniform grid");
     for (const MeasureView& v : views) {
         std::cerr << "06_raster: timing frames on " << v.name << "...\n";
         RasterScene raster = RasterScene::fromScene(v.scene);
@@ -186,17 +174,10 @@ Table measureFrameTimes(const std::vector<MeasureView>& views, const MeasureSett
 }
 
 Table measureShadowBias(const MeasureView& v, const MeasureSettings& m) {
-    Table t;
-    t.id = "shadow_bias";
-    t.title = "Shadow map depth bias against the ray tracer's shadows: acne and peter-panning";
-    t.columns = {"bias (x diagonal)",
-                 "acne pixels",
-                 "peter-panning pixels",
-                 "disagree %",
-                 "map size",
-                 "ms map + shading",
-                 "min ms",
-                 "max ms"};
+    Table t("shadow_bias",
+            "Shadow map depth bias against the ray tracer's shadows: acne and peter-panning",
+            {"bias (x diagonal)", "acne pixels", "peter-panning pixels", "disagree %", "map size",
+             "ms map + shading", "min ms", "max ms"});
     t.note =
         v.name +
         ", first light; acne: the map shadows a point the ray tracer lights; "
@@ -236,14 +217,12 @@ Table measureShadowBias(const MeasureView& v, const MeasureSettings& m) {
 }
 
 Table measureShadowMethods(const MeasureView& v, const MeasureSettings& m) {
-    Table t;
-    t.id = "shadows";
-    t.title = "Shadows two ways against the ray tracer's shadow rays";
-    t.columns = {"method",       "pixels compared", "disagree", "disagree %",
-                 "ms per frame", "min ms",          "max ms"};
-    t.note = v.name + ", first light, single thread, median of " + std::to_string(m.repeats) +
-             " (min, max); the frame time includes rasterizing and shading (and building the map); "
-             "the reference: the ray tracer's shadow rays (its time: 2 frames)";
+    Table t(
+        "shadows", "Shadows two ways against the ray tracer's shadow rays",
+        {"method", "pixels compared", "disagree", "disagree %", "ms per frame", "min ms", "max ms"},
+        v.name + ", first light, single thread, median of " + std::to_string(m.repeats) +
+            " (min, max); the frame time includes rasterizing and shading (and building the map); "
+            "the reference: the ray tracer's shadow rays (its time: 2 frames)");
     t.timeAndError("ms per frame", "min ms", "max ms", "disagree %");
     RasterScene raster = RasterScene::fromScene(v.scene);
     RasterSettings rs = rasterSettings(m);
@@ -294,20 +273,18 @@ Table measureShadowMethods(const MeasureView& v, const MeasureSettings& m) {
 }
 
 Table measureCulling(const std::vector<MeasureView>& views, const MeasureSettings& m) {
-    Table t;
-    t.id = "culling";
-    t.title =
-        "View-frustum culling with step 04's hierarchy: boxes culled and kept, triangles drawn";
-    t.columns = {"view",       "test",           "boxes visited",   "boxes culled",
-                 "boxes kept", "triangles kept", "triangles drawn", "ms per frame",
-                 "identical",  "min ms",         "max ms",          "pixels differing"};
-    t.note =
+    Table t(
+        "culling",
+        "View-frustum culling with step 04's hierarchy: boxes culled and kept, triangles drawn",
+        {"view", "test", "boxes visited", "boxes culled", "boxes kept", "triangles kept",
+         "triangles drawn", "ms per frame", "identical", "min ms", "max ms", "pixels differing"},
         "binned-SAH hierarchy over the mesh; test: none, planes (p-vertex), planes + corners; "
         "ms: median of " +
-        std::to_string(m.repeats) +
-        " frames (culling walk + rasterizing, single thread; min, max); identical: the triangle "
-        "and depth buffers equal the unculled frame's; pixels differing: pixels where either "
-        "buffer differs from the unculled frame's, the reference";
+            std::to_string(m.repeats) +
+            " frames (culling walk + rasterizing, single thread; min, max); identical: the "
+            "triangle "
+            "and depth buffers equal the unculled frame's; pixels differing: pixels where either "
+            "buffer differs from the unculled frame's, the reference");
     t.timeAndError("ms per frame", "min ms", "max ms", "pixels differing");
     std::vector<MeasureView> cases;
     for (const MeasureView& v : views) cases.push_back(v);
@@ -352,17 +329,14 @@ Table measureCulling(const std::vector<MeasureView>& views, const MeasureSetting
 Table measureInterpolation(const MeasureView& bunny, const MeasureSettings& m,
                            const std::string& pngStem,
                            std::vector<std::pair<std::string, std::string>>& images) {
-    Table t;
-    t.id = "interpolation";
-    t.title =
-        "Affine against perspective-correct interpolation: position error against the ray tracer";
-    t.columns = {
-        "view",   "weights", "mean error (x diagonal)", "max error (x diagonal)", "ms/frame",
-        "min ms", "max ms"};
-    t.note =
+    Table t(
+        "interpolation",
+        "Affine against perspective-correct interpolation: position error against the ray tracer",
+        {"view", "weights", "mean error (x diagonal)", "max error (x diagonal)", "ms/frame",
+         "min ms", "max ms"},
         "the interpolated surface point against the ray tracer's hit point, over pixels where "
         "both see the same triangle; ms/frame: rasterizing with those weights, median of " +
-        std::to_string(m.repeats) + " (min, max), single thread";
+            std::to_string(m.repeats) + " (min, max), single thread");
     t.timeAndError("ms/frame", "min ms", "max ms", "max error (x diagonal)");
     // A floor of two triangles seen at a grazing angle: large triangles, strong perspective.
     MeasureView floor{"floor quad (grazing)", Scene{}, {}};
@@ -447,25 +421,16 @@ size_t buffersDiffering(const FrameBuffers& a, const FrameBuffers& b) {
 }  // namespace
 
 Table measureVertexPrecalc(const std::vector<MeasureView>& views, const MeasureSettings& m) {
-    Table t;
-    t.id = "vertex_precalc";
-    t.title =
-        "Precalculation: the vertex work done once per vertex, per triangle corner, per pixel";
-    t.columns = {"view",
-                 "vertex work",
-                 "ms/frame",
-                 "min ms",
-                 "max ms",
-                 "speed-up",
-                 "vertex transforms",
-                 "transforms per vertex",
-                 "pixels differing"};
-    t.note = std::to_string(m.width) + "x" + std::to_string(m.height) +
-             ", rasterizing only (no shading), one thread, median of " +
-             std::to_string(m.repeats + 2) +
-             " frames interleaved; vertex work: the transform to clip space (and per pixel also "
-             "the divide by w and the viewport); speed-up against per pixel; pixels differing: "
-             "triangle, depth or weights differ from the once-per-vertex frame's, bit for bit";
+    Table t("vertex_precalc",
+            "Precalculation: the vertex work done once per vertex, per triangle corner, per pixel",
+            {"view", "vertex work", "ms/frame", "min ms", "max ms", "speed-up", "vertex transforms",
+             "transforms per vertex", "pixels differing"},
+            std::to_string(m.width) + "x" + std::to_string(m.height) +
+                ", rasterizing only (no shading), one thread, median of " +
+                std::to_string(m.repeats + 2) +
+                " frames interleaved; vertex work: the transform to clip space (and per pixel also "
+                "the divide by w and the viewport); speed-up against per pixel; pixels differing: "
+                "triangle, depth or weights differ from the once-per-vertex frame's, bit for bit");
     const VertexWork works[] = {VertexWork::PerPixel, VertexWork::PerCorner,
                                 VertexWork::OncePerVertex};
     for (const MeasureView& v : views) {
@@ -494,21 +459,17 @@ Table measureVertexPrecalc(const std::vector<MeasureView>& views, const MeasureS
 
 Table measureTexture(const MeasureSettings& m, const std::string& pngStem,
                      std::vector<std::pair<std::string, std::string>>& images) {
-    Table t;
-    t.id = "texture";
-    t.title =
-        "Texture coordinates on a floor: perspective-correct and affine against the ray tracer";
-    t.columns = {"renderer",         "ms/frame",
-                 "min ms",           "max ms",
-                 "pixels differing", "differing % of floor",
-                 "colour differs",   "max texcoord error (texels)"};
-    t.note = std::to_string(m.width) + "x" + std::to_string(m.height) +
-             ", a 20 x 20 texel checker on a floor quad of two triangles seen at a low angle, "
-             "no shadows, one thread, median of " +
-             std::to_string(m.repeats) +
-             " frames; pixels differing: another texel than the ray tracer's (or the floor on "
-             "one side only); colour differs: a channel differs by more than 1e-3 (linear) from "
-             "the ray tracer's image; texcoord error where both see the floor";
+    Table t("texture",
+            "Texture coordinates on a floor: perspective-correct and affine against the ray tracer",
+            {"renderer", "ms/frame", "min ms", "max ms", "pixels differing", "differing % of floor",
+             "colour differs", "max texcoord error (texels)"},
+            std::to_string(m.width) + "x" + std::to_string(m.height) +
+                ", a 20 x 20 texel checker on a floor quad of two triangles seen at a low angle, "
+                "no shadows, one thread, median of " +
+                std::to_string(m.repeats) +
+                " frames; pixels differing: another texel than the ray tracer's (or the floor on "
+                "one side only); colour differs: a channel differs by more than 1e-3 (linear) from "
+                "the ray tracer's image; texcoord error where both see the floor");
     TexturedFloor floor = texturedFloor(float(m.width) / float(m.height));
     attachGrid(floor.scene);
     const Camera& camera = floor.scene.camera;

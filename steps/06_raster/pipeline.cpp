@@ -7,7 +7,6 @@
 #include "core/mesh.hpp"
 #include "core/render.hpp"
 #include "core/timing.hpp"
-#include "core/triangle_hit.hpp"
 
 namespace boxes {
 

@@ -10,7 +10,7 @@
 #include <cstdint>
 #include <glm/mat4x4.hpp>
 
-#include "core/camera.hpp"
+#include "core/scene.hpp"
 
 namespace boxes {
 

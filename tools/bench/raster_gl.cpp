@@ -43,6 +43,9 @@ double processCpuSeconds() {
 }
 
 // The GL 3.3 core functions this harness calls, loaded through SDL as core/window.cpp does.
+// A loader of its own, not the window's: each lists the functions it calls (this one
+// buffers, framebuffers, uniforms and the depth test; the window a textured quad), and the
+// bench's harness stays out of the core.
 #define RASTER_GL_FUNCTIONS(X)                                                             \
     X(void, AttachShader, (GLuint, GLuint))                                                \
     X(void, BindBuffer, (GLenum, GLuint))                                                  \

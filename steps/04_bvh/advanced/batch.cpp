@@ -4,7 +4,7 @@
 #include <atomic>
 #include <cstdlib>
 
-#include "core/parallel.hpp"
+#include "core/render.hpp"
 
 namespace boxes {
 
@@ -20,6 +20,11 @@ bool traceUsesAvx2() {
 void traceBatch(const Bvh& bvh, const std::vector<Ray>& rays, std::vector<TraceHit>& hits,
                 int threads) {
     traceBatchOf(bvh, rays, hits, threads);
+}
+
+void traceBatchChapter(const Bvh& bvh, const std::vector<Ray>& rays, std::vector<TraceHit>& hits,
+                       int threads) {
+    traceBatchOf(ChapterTraversal{bvh}, rays, hits, threads);
 }
 
 TraversalCounts countWork(const Bvh& bvh, const std::vector<Ray>& rays) {

@@ -5,16 +5,17 @@
 
 #include <cstdint>
 #include <functional>
+#include <type_traits>
 #include <vector>
 
-#include "04_bvh/trace.hpp"
+#include "04_bvh/advanced/traverse.hpp"
 
 namespace boxes {
 
 // The work of tracing a batch of rays, summed over the rays (`trace --count`): a count of
-// what the traversal does, the same on every machine, where a time is not. The binary
-// tree's loop is exercise 4.4, so only its triangle tests are counted (from the leaf test
-// it calls); the wide trees' loops count their nodes, leaves and packets too.
+// what the traversal does, the same on every machine, where a time is not. For the binary
+// tree only its triangle tests are counted (from the leaf test its loop calls); the wide
+// trees' loops count their nodes, leaves and packets too.
 struct TraversalCounts {
     uint64_t rays = 0;
     uint64_t nodes = 0;      // wide nodes whose boxes were tested (wide trees only)
@@ -43,11 +44,14 @@ struct TraversalCounter {
 // batches, chunks of 1,024 rays handed out dynamically.
 void traceBatch(const Bvh& bvh, const std::vector<Ray>& rays, std::vector<TraceHit>& hits,
                 int threads);
+// The same through the chapter's traversal (`trace --chapter`).
+void traceBatchChapter(const Bvh& bvh, const std::vector<Ray>& rays, std::vector<TraceHit>& hits,
+                       int threads);
 void traceBatchBruteForce(const Mesh& mesh, const std::vector<Ray>& rays,
                           std::vector<TraceHit>& hits, int threads);
 // The batch loop itself: f(begin, end) on chunks of 1,024 of [0, count), handed out
 // dynamically to `threads` threads (0: all cores): the calling thread and the workers core
-// keeps between calls (core/parallel.hpp). The first exception ends the batch early and
+// keeps between calls (core/render.hpp, runOnThreads). The first exception ends the batch early and
 // reaches the caller. Every batch tracer of the step runs on it (traceBatchOf below,
 // brute force).
 void forEachRayChunk(size_t count, int threads, const std::function<void(size_t, size_t)>& f);
@@ -65,11 +69,19 @@ void forEachRayChunk(size_t count, int threads, const std::function<void(size_t,
 bool traceUsesAvx2();
 
 // A tree's nearest hit in the batch loop; kAvx selects the wide trees' AVX box test (their
-// overload is in bvh4.hpp). The binary tree has none: its loop is exercise 4.4, through
-// the one set-up of trace.hpp.
+// overload is in bvh4.hpp). The binary tree has none: its loop is the engine's copy of
+// exercise 4.4's (traverse.hpp here).
 template <bool kAvx>
 inline TraceHit batchNearestHit(const Bvh& bvh, const Ray& ray) {
-    return traceNearest(bvh, ray);
+    return traceNearestFast(bvh, ray);
+}
+// `trace --chapter`: the binary tree through the chapter's own loop (your exercise 4.4).
+struct ChapterTraversal {
+    const Bvh& bvh;
+};
+template <bool kAvx>
+inline TraceHit batchNearestHit(const ChapterTraversal& tree, const Ray& ray) {
+    return traceNearest(tree.bvh, ray);
 }
 
 namespace detail {
@@ -107,7 +119,12 @@ template <typename Tree>
 TraversalCounts countWorkOf(const Tree& tree, const std::vector<Ray>& rays) {
     TraversalCounts counts;
     counts.rays = rays.size();
-    for (const Ray& ray : rays) traceNearest(tree, ray, TraversalCounter{&counts});
+    for (const Ray& ray : rays) {
+        if constexpr (std::is_same_v<Tree, Bvh>)
+            traceNearestFast(tree, ray, TraversalCounter{&counts});
+        else
+            traceNearest(tree, ray, TraversalCounter{&counts});
+    }
     return counts;
 }
 TraversalCounts countWork(const Bvh& bvh, const std::vector<Ray>& rays);

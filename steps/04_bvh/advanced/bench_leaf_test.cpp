@@ -18,7 +18,7 @@
 #include "01_triangle/triangle.hpp"
 #include "04_bvh/advanced/build.hpp"
 #include "04_bvh/advanced/rays.hpp"
-#include "04_bvh/trace.hpp"
+#include "04_bvh/advanced/traverse.hpp"
 
 using namespace boxes;
 
@@ -30,7 +30,7 @@ uint32_t nearestStep01(const Bvh& bvh, const Ray& ray, float& tClosest) {
     TraversalRay traversal(ray, bvh);
     if (!entersRoot(bvh, traversal)) return kTraversalMiss;
     const LeafTriangle* tris = bvh.leafTriangles.data();
-    return traverseNearest(bvh, traversal, tClosest, [&](uint32_t s, float& tmax) {
+    return traverseNearestFast(bvh, traversal, tClosest, [&](uint32_t s, float& tmax) {
         Ray shorter = ray;
         shorter.tmax = tmax;
         auto h = intersectWatertight(shorter, Triangle{tris[s].a, tris[s].b, tris[s].c});
@@ -41,7 +41,7 @@ uint32_t nearestStep01(const Bvh& bvh, const Ray& ray, float& tClosest) {
 }
 
 uint32_t nearestStep04(const Bvh& bvh, const Ray& ray, float& tClosest) {
-    return nearestSlot(bvh, ray, tClosest);
+    return nearestSlotFast(bvh, ray, tClosest);
 }
 
 struct Fixture {

@@ -25,6 +25,8 @@ double processCpuSeconds() {
 
 // `trace`: build, trace every ray (median of --repeat), write HITS.bin, one JSON line.
 int runTrace(const TraceCommandOptions& o) {
+    if (o.chapter && o.width != 2)
+        throw InputError("--chapter traces the binary tree: it goes with --width 2");
     Mesh mesh = loadObj(o.mesh);
     std::vector<Ray> rays = readRays(o.rays);
     BvhBuildOptions build;
@@ -49,6 +51,8 @@ int runTrace(const TraceCommandOptions& o) {
             traceBatch(wide, rays, hits, o.threads);
         else if (o.width == 8)
             traceBatch(wide8, rays, hits, o.threads);
+        else if (o.chapter)
+            traceBatchChapter(bvh, rays, hits, o.threads);
         else
             traceBatch(bvh, rays, hits, o.threads);
         seconds.push_back(watch.seconds());
@@ -70,6 +74,7 @@ int runTrace(const TraceCommandOptions& o) {
                         {"builder", bvhBuilderName(build.builder)},
                         {"width", o.width},
                         {"isa", traceUsesAvx2() ? "avx2" : "baseline"},
+                        {"traversal", o.chapter ? "chapter" : "engine"},
                         {"bins", o.bins},
                         {"repeat", o.repeat},
                         {"nodes", stats.nodes},
@@ -234,6 +239,9 @@ EngineCommands::EngineCommands(CLI::App& app) {
     traceCommand_->add_option("--bins", trace_.bins, "binned SAH: bins per axis")
         ->check(CLI::Range(2, 256))
         ->capture_default_str();
+    traceCommand_->add_flag("--chapter", trace_.chapter,
+                            "--width 2 through the chapter's traversal (exercise 4.4) instead "
+                            "of the engine's copy (advanced/traverse.hpp)");
     traceCommand_->add_flag("--count", trace_.count,
                             "also count the work per ray (one more, untimed pass): "
                             "triangles tested; with --width 4 or 8 also nodes, leaves "

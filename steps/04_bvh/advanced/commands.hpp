@@ -17,6 +17,7 @@ struct TraceCommandOptions {
     std::string mesh, rays, hits, builder = "sah";
     int threads = 1, repeat = 1, bins = BvhBuildOptions{}.bins, width = 2;
     bool count = false;
+    bool chapter = false;  // width 2 through the chapter's traversal, not the engine's copy
 };
 
 // `rays`: a ray set written as RAYS.bin, for any tracer (the bench gives the same file to

@@ -10,11 +10,9 @@
 namespace boxes {
 
 Table measureBvhCracks(const std::vector<NamedMesh>& meshes, size_t raysPerFeature, uint64_t seed) {
-    Table t;
-    t.id = "bvh_cracks";
-    t.title = "Cracks through the hierarchy: rays aimed at shared edges and vertices";
-    t.columns = {"mesh",   "builder", "feature", "rays", "cracks", "differ from brute force",
-                 "ns/ray", "min ns",  "max ns"};
+    Table t("bvh_cracks", "Cracks through the hierarchy: rays aimed at shared edges and vertices",
+            {"mesh", "builder", "feature", "rays", "cracks", "differ from brute force", "ns/ray",
+             "min ns", "max ns"});
     t.note =
         "a crack: a ray that some triangle at the feature hits, for which the hierarchy "
         "reports nothing as near; watertight leaf test, conservative box test; 'differ' "

@@ -8,7 +8,7 @@
 #include <vector>
 
 #include "04_bvh/trace.hpp"
-#include "core/camera.hpp"
+#include "core/scene.hpp"
 
 namespace boxes {
 

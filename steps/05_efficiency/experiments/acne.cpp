@@ -8,12 +8,10 @@ namespace boxes {
 using namespace lab;
 
 Table measureAcne(const LabOptions& o) {
-    Table t;
-    t.id = "acne";
-    t.title = "Self-intersection acne: lit pixels whose shadow ray hits the surface it starts on";
-    t.columns = {"offset",      "shadow ray origin", "lit pixels",
-                 "acne pixels", "ns/shadow ray",     "min ns",
-                 "max ns"};
+    Table t("acne",
+            "Self-intersection acne: lit pixels whose shadow ray hits the surface it starts on",
+            {"offset", "shadow ray origin", "lit pixels", "acne pixels", "ns/shadow ray", "min ns",
+             "max ns"});
     t.note =
         "the 'diffuse' spheres scene moved by offset*(1,-0.7,0.3) (float), 160x120 primary hits "
         "facing a light; a convex surface cannot shadow itself, so any hit of the shadow ray on "

@@ -8,13 +8,12 @@ namespace boxes {
 using namespace lab;
 
 Table measureAntiAliasing(const Scene& scene, const LabOptions& o) {
-    Table t;
-    t.id = "antialiasing";
-    t.title = "Anti-aliasing: error against a 256 samples per pixel reference, and time";
-    t.columns = {"samples/pixel", "ms/frame", "min ms", "max ms", "RMSE", "max error"};
-    t.note = "scene '" + scene.name +
-             "', 96x72, stratified jittered samples, all threads, median of repeats; "
-             "RMSE over all channels in linear units against 256 samples per pixel (another seed)";
+    Table t(
+        "antialiasing", "Anti-aliasing: error against a 256 samples per pixel reference, and time",
+        {"samples/pixel", "ms/frame", "min ms", "max ms", "RMSE", "max error"},
+        "scene '" + scene.name +
+            "', 96x72, stratified jittered samples, all threads, median of repeats; "
+            "RMSE over all channels in linear units against 256 samples per pixel (another seed)");
     RenderSettings s;
     s.width = sized(o, 96);
     s.height = sized(o, 72);

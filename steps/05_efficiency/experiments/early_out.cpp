@@ -12,11 +12,9 @@ namespace boxes {
 using namespace lab;
 
 Table measureEarlyOut(LabBvhMesh& mesh, const LabOptions& o) {
-    Table t;
-    t.id = "early_out";
-    t.title = "Early out: box and triangle tests per ray and time, with and without";
-    t.columns = {"rays",   "method", "count",  "box tests/ray", "triangle tests/ray",
-                 "us/ray", "min us", "max us", "speed-up",      "answers differing"};
+    Table t("early_out", "Early out: box and triangle tests per ray and time, with and without",
+            {"rays", "method", "count", "box tests/ray", "triangle tests/ray", "us/ray", "min us",
+             "max us", "speed-up", "answers differing"});
     t.note =
         "the mesh in step 04's hierarchy (full-sweep SAH, leaves of at most 8 triangles), the "
         "lab's own traversal; primary rays of an 80x60 view, shadow rays from their hits to the "

@@ -51,22 +51,19 @@ const std::vector<std::string>& effectsSceneNames() {
 }
 
 Table measureEffects(const LabOptions& o) {
-    Table t;
-    t.id = "effects";
-    t.title =
+    Table t(
+        "effects",
         "Effects on demand: rays and time with the scene analysis against the fair baseline "
-        "(zero-weight rays skipped, no analysis)";
-    t.columns = {"scene",      "variant",    "shadow",          "reflection",
-                 "refraction", "total rays", "x baseline",      "ms/frame",
-                 "min ms",     "max ms",     "max 8-bit error", "bit-identical"};
-    t.note =
+        "(zero-weight rays skipped, no analysis)",
+        {"scene", "variant", "shadow", "reflection", "refraction", "total rays", "x baseline",
+         "ms/frame", "min ms", "max ms", "max 8-bit error", "bit-identical"},
         "160x120, max depth 5, one thread, median of repeats interleaved round-robin; baseline: "
         "RenderSettings::analysis = AnalysisParts::none() (the renderer still skips lights "
         "behind the surface and reflection or refraction of weight 0); 'every ray': "
         "forceAllEffects, zero weights traced too (what a renderer without any test would "
         "do); x baseline: total rays over the baseline's; the error is against the baseline image; "
         "bit-identical: the float images "
-        "equal";
+        "equal");
     struct Variant {
         const char* name;
         AnalysisParts parts;
@@ -106,11 +103,10 @@ Table measureEffects(const LabOptions& o) {
 }
 
 Table measureEffectParts(const LabOptions& o) {
-    Table t;
-    t.id = "effects_parts";
-    t.title = "Effects on demand, part by part: the shadow rays each part of the analysis saves";
-    t.columns = {"scene",    "variant", "shadow rays", "saved by the part",
-                 "ms/frame", "min ms",  "max ms",      "max 8-bit error"};
+    Table t("effects_parts",
+            "Effects on demand, part by part: the shadow rays each part of the analysis saves",
+            {"scene", "variant", "shadow rays", "saved by the part", "ms/frame", "min ms", "max ms",
+             "max 8-bit error"});
     t.note =
         "160x120, max depth 5, one thread, median of repeats interleaved round-robin; 'all "
         "but': every other part on, and the part saves its rays minus the rays with every "
@@ -151,12 +147,11 @@ Table measureEffectParts(const LabOptions& o) {
 }
 
 Table measureEffectIdentity(const LabOptions& o) {
-    Table t;
-    t.id = "effects_identity";
-    t.title =
+    Table t(
+        "effects_identity",
         "Effects on demand at the run's image size: every built-in scene and every shipped mesh, "
-        "bit-identical with and without the analysis";
-    t.columns = {"scene", "pixels", "rays, baseline", "rays, analysis", "saved %", "bit-identical"};
+        "bit-identical with and without the analysis",
+        {"scene", "pixels", "rays, baseline", "rays, analysis", "saved %", "bit-identical"});
     const int w = o.quick ? sized(o, 160) : o.width, h = o.quick ? sized(o, 120) : o.height;
     t.note = std::to_string(w) + "x" + std::to_string(h) +
              ", max depth 5, every thread; baseline: AnalysisParts::none(); meshes in step 04's "

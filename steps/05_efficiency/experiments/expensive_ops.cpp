@@ -127,11 +127,10 @@ float shadeOptimized(const SphereField& f, Vec3 origin, Vec3 dir, Ops<Count> ops
 }  // namespace
 
 Table measureExpensiveOps(const LabOptions& o) {
-    Table t;
-    t.id = "expensive_ops";
-    t.title = "Expensive operations: square roots and divisions per ray, and time per frame";
-    t.columns = {"variant", "sqrt/ray", "div/ray",        "ms/frame",
-                 "min ms",  "max ms",   "max difference", "pixels > 0.1%"};
+    Table t("expensive_ops",
+            "Expensive operations: square roots and divisions per ray, and time per frame",
+            {"variant", "sqrt/ray", "div/ray", "ms/frame", "min ms", "max ms", "max difference",
+             "pixels > 0.1%"});
     t.note =
         "48 spheres, one light, 160x120 primary rays with diffuse shading, one thread, median of "
         "repeats; counts from the same code with counting compiled in; differences against the "

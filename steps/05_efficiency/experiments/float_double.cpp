@@ -36,20 +36,17 @@ std::optional<T> mtT(const RayT<T>& ray, const Vec3T<T>& a, const Vec3T<T>& b, c
 }  // namespace
 
 Table measureFloatDouble(const LabOptions& o) {
-    Table t;
-    t.id = "float_double";
-    t.title =
+    Table t(
+        "float_double",
         "Float or double: time per test and float's error against double, near and far from the "
-        "origin";
-    t.columns = {"variant",         "offset",     "ns/test",
-                 "min ns",          "max ns",     "median rel t error",
-                 "max rel t error", "flipped /1M"};
-    t.note =
+        "origin",
+        {"variant", "offset", "ns/test", "min ns", "max ns", "median rel t error",
+         "max rel t error", "flipped /1M"},
         "4096 rays per shape, half aimed at the shape, half just past it; scene and rays built in "
         "double and moved by offset*(1,-0.7,0.3); float holds them rounded to float; the reference "
         "is the same test in double on the double scene; flipped: hit in one precision, miss in "
         "the other; ray/sphere: core "
-        "intersectSphere; ray/triangle: Moller-Trumbore; one thread, median of repeats";
+        "intersectSphere; ray/triangle: Moller-Trumbore; one thread, median of repeats");
     const size_t n = size_t(samples(o, 4096));
     for (double offset : {0.0, 1e3, 1e4, 1e5}) {
         // The scene is built in double; the float renderer holds it rounded to float.

@@ -14,10 +14,9 @@ namespace boxes {
 using namespace lab;
 
 Table measureInverseSqrt(const LabOptions& o) {
-    Table t;
-    t.id = "rsqrt";
-    t.title = "Reciprocal square root: exact against the bit trick, with and without a Newton step";
-    t.columns = {"variant", "ns/call", "min ns", "max ns", "max relative error"};
+    Table t("rsqrt",
+            "Reciprocal square root: exact against the bit trick, with and without a Newton step",
+            {"variant", "ns/call", "min ns", "max ns", "max relative error"});
     t.note =
         "error: over 1,000,000 values log-spaced in [1e-6, 1e6] against 1/sqrt in double; time: "
         "4096 "

@@ -62,20 +62,18 @@ using namespace lab;
 using language::KernelVariant;
 
 Table measureLanguage(const LabOptions& o) {
-    Table t;
-    t.id = "language";
-    t.title =
+    Table t(
+        "language",
         "The choice of language, within one: the same ray/sphere kernel under different compiler "
-        "flags, in float and double";
-    t.columns = {"variant",        "flags",           "type",   "ns/ray", "min ns", "max ns",
-                 "x O2 same type", "max rel t error", "flipped"};
-    t.note =
+        "flags, in float and double",
+        {"variant", "flags", "type", "ns/ray", "min ns", "max ns", "x O2 same type",
+         "max rel t error", "flipped"},
         "4096 rays (quick: 100) from (0,0,8) towards random points of a field of 32 spheres, every "
         "ray against every sphere, nearest t; built in double and rounded for float; the kernel "
         "compiled once per row's flags, never -ffast-math; error: "
         "the largest |t - t_ref| / t_ref over the rays both hit, against the double O2 result; "
         "flipped: hit in one, miss in the other; one thread, variants interleaved round by "
-        "round, median of repeats";
+        "round, median of repeats");
     std::mt19937_64 rng(o.seed);
     std::uniform_real_distribution<double> u(-1.0, 1.0);
     std::vector<double> spheres, rays;

@@ -12,20 +12,11 @@ namespace boxes {
 using namespace lab;
 
 Table measureLightRadius(const LabOptions& o) {
-    Table t;
-    t.id = "light_radius";
-    t.title = "Lights with a finite radius: time saved and the largest pixel difference";
-    t.columns = {"scene",
-                 "radius rule",
-                 "largest radius",
-                 "ms/frame",
-                 "min ms",
-                 "max ms",
-                 "speed-up",
-                 "light evaluations skipped/pixel",
-                 "shadow rays/pixel",
-                 "max diff (8-bit sRGB)",
-                 "max diff (linear, 1/255 units)"};
+    Table t("light_radius",
+            "Lights with a finite radius: time saved and the largest pixel difference",
+            {"scene", "radius rule", "largest radius", "ms/frame", "min ms", "max ms", "speed-up",
+             "light evaluations skipped/pixel", "shadow rays/pixel", "max diff (8-bit sRGB)",
+             "max diff (linear, 1/255 units)"});
     t.note =
         "160x120, one thread, median of repeats interleaved round-robin; radius = sqrt(I_max / "
         "threshold) (exercise 5.5); differences against the same scene with infinite radii, in "

@@ -11,17 +11,15 @@ namespace boxes {
 using namespace lab;
 
 Table measureMeasuring(const LabOptions& o) {
-    Table t;
-    t.id = "measuring";
-    t.title =
+    Table t(
+        "measuring",
         "Measuring itself: one call per stopwatch sample against batches of calls (median of "
-        "repeats)";
-    t.columns = {"operation", "method", "samples", "median ns", "min ns", "max ns", "max/min"};
-    t.note =
+        "repeats)",
+        {"operation", "method", "samples", "median ns", "min ns", "max ns", "max/min"},
         "ray/sphere test (core intersectSphere, float) on one thread; 'one call': a steady_clock "
         "stopwatch around each single call, 2001 samples; 'batch': calls repeated until a batch "
         "takes >= 20 ms, " +
-        std::to_string(std::max(o.repeats, 5)) + " batches, time per call";
+            std::to_string(std::max(o.repeats, 5)) + " batches, time per call");
     std::mt19937_64 rng(o.seed);
     std::uniform_real_distribution<float> u(-1.0f, 1.0f);
     std::vector<Ray> rays;

@@ -86,19 +86,17 @@ std::vector<OpCost> measureOpCosts(const LabOptions& o) {
 }
 
 Table measureOpCost(const LabOptions& o) {
-    Table t;
-    t.id = "op_cost";
-    t.title =
+    Table t(
+        "op_cost",
         "The cost of an operation: ns per sin, cos, sqrt, /, *, +, - in float and double, and "
-        "the error of one operation";
-    t.columns = {"operation", "type", "ns/op", "min ns", "max ns", "x addition", "max rel error"};
-    t.note =
+        "the error of one operation",
+        {"operation", "type", "ns/op", "min ns", "max ns", "x addition", "max rel error"},
         "time: a dependent chain x = op(x) (sin, cos, sqrt; x / c, x * c, x + c, x - c with c "
         "unknown to the compiler), so each operation waits for the one before (latency, no "
         "vectorization); 50,000 steps a sample, one thread, median of three times the repeats; x "
         "addition: against + in the same type; "
         "error: the largest relative error of one operation on the chain's inputs against the "
-        "same operation in long double on the same input";
+        "same operation in long double on the same input");
     std::vector<OpCost> costs = measureOpCosts(o);
     auto find = [&](const std::string& op, const std::string& type) {
         for (const OpCost& c : costs)

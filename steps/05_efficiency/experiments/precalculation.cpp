@@ -12,25 +12,17 @@ namespace boxes {
 using namespace lab;
 
 Table measurePrecalculation(LabBvhMesh& mesh, const LabOptions& o) {
-    Table t;
-    t.id = "precalc";
-    t.title =
-        "Precalculation and early out: time per frame of a mesh, each optimization added in turn";
-    t.columns = {"variant",
-                 "ms/frame",
-                 "min ms",
-                 "max ms",
-                 "speed-up",
-                 "box tests/pixel",
-                 "triangle tests/pixel",
-                 "pixels differing"};
-    t.note =
+    Table t(
+        "precalc",
+        "Precalculation and early out: time per frame of a mesh, each optimization added in turn",
+        {"variant", "ms/frame", "min ms", "max ms", "speed-up", "box tests/pixel",
+         "triangle tests/pixel", "pixels differing"},
         "the mesh alone (no floor) in step 04's hierarchy, the lab's traversal with each switch "
         "(Moller-Trumbore and the lab's slab tests, not step 04's robust ones), "
         "96x72, primary and shadow rays, one thread, median of repeats interleaved "
         "(one frame of each variant per round); pixels "
         "differing: "
-        "against the first row, any float difference";
+        "against the first row, any float difference");
     // The scene refers to the caller's mesh (no ownership: it outlives the scene).
     std::shared_ptr<LabBvhMesh> cm(&mesh, [](LabBvhMesh*) {});
     Scene scene;

@@ -9,13 +9,12 @@ namespace boxes {
 using namespace lab;
 
 Table measurePreviews(const Scene& scene, const LabOptions& o) {
-    Table t;
-    t.id = "previews";
-    t.title = "Preview modes: time per frame while the camera moves, against the full render";
-    t.columns = {"mode", "ms/frame", "min ms", "max ms", "rays/frame", "RMSE against full"};
-    t.note = "scene '" + scene.name +
-             "', 320x240, all threads, median of repeats; adaptive at the scale it "
-             "settles on for a 1/30 s target";
+    Table t("previews",
+            "Preview modes: time per frame while the camera moves, against the full render",
+            {"mode", "ms/frame", "min ms", "max ms", "rays/frame", "RMSE against full"},
+            "scene '" + scene.name +
+                "', 320x240, all threads, median of repeats; adaptive at the scale it "
+                "settles on for a 1/30 s target");
     RenderSettings s;
     s.width = sized(o, 320);
     s.height = sized(o, 240);

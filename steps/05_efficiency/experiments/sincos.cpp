@@ -13,10 +13,9 @@ namespace boxes {
 using namespace lab;
 
 Table measureSinCos(const LabOptions& o) {
-    Table t;
-    t.id = "sincos";
-    t.title = "Sine from a table: time per call against the largest error over the full circle";
-    t.columns = {"variant", "ns/call", "min ns", "max ns", "max abs error", "stated bound"};
+    Table t("sincos",
+            "Sine from a table: time per call against the largest error over the full circle",
+            {"variant", "ns/call", "min ns", "max ns", "max abs error", "stated bound"});
     t.note =
         "error: max |f(x) - sin(x)| (sin in double of the float angle x) over 1,000,000 angles "
         "evenly spaced in [0, 2 pi); time: 4096 angles, 3 in 4 in [0, 2 pi), 1 in 4 in [-20, 20] "

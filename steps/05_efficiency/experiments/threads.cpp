@@ -4,7 +4,7 @@
 
 #include "05_efficiency/experiments/lab_helpers.hpp"
 #include "05_efficiency/measure.hpp"
-#include "core/parallel.hpp"
+#include "core/render.hpp"
 #include "core/timing.hpp"
 
 namespace boxes {
@@ -54,11 +54,9 @@ Image renderScheduled(const Renderer& renderer, int threads, Schedule schedule) 
 }
 
 Table measureThreads(const Scene& scene, const LabOptions& o) {
-    Table t;
-    t.id = "threads";
-    t.title = "Threads: speed-up over one thread, and how the work is handed out";
-    t.columns = {"threads",  "schedule",     "ms/frame",     "min ms",          "max ms",
-                 "speed-up", "speed-up min", "speed-up max", "pixels differing"};
+    Table t("threads", "Threads: speed-up over one thread, and how the work is handed out",
+            {"threads", "schedule", "ms/frame", "min ms", "max ms", "speed-up", "speed-up min",
+             "speed-up max", "pixels differing"});
     int all = resolveThreads(0);
     const int repeats = std::max(o.repeats, 7);
     t.note = "scene '" + scene.name + "', " + std::to_string(sized(o, 320)) + "x" +

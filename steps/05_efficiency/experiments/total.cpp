@@ -8,17 +8,16 @@
 namespace boxes {
 
 Table measureTotalSpeedup(const Scene& scene, const LabOptions& o) {
-    Table t;
-    t.id = "total";
-    t.title = "All together on the scene: time per frame as each optimization is switched on";
-    t.columns = {"variant",        "ms/frame",        "min ms",        "max ms",
-                 "ratio to naive", "max 8-bit error", "pixels changed"};
-    t.note = "scene '" + scene.name +
-             "', 160x120, max depth 5, median of repeats interleaved round-robin; the mesh "
-             "optimizations "
-             "(precomputed data, early out) are in the precalc table; error: largest difference "
-             "of the PNG from the naive render's in 8-bit sRGB steps, and the pixels whose PNG "
-             "value differs (the finite light radius may move a pixel by one step)";
+    Table t("total",
+            "All together on the scene: time per frame as each optimization is switched on",
+            {"variant", "ms/frame", "min ms", "max ms", "ratio to naive", "max 8-bit error",
+             "pixels changed"},
+            "scene '" + scene.name +
+                "', 160x120, max depth 5, median of repeats interleaved round-robin; the mesh "
+                "optimizations "
+                "(precomputed data, early out) are in the precalc table; error: largest difference "
+                "of the PNG from the naive render's in 8-bit sRGB steps, and the pixels whose PNG "
+                "value differs (the finite light radius may move a pixel by one step)");
     Scene infinite = scene;
     for (auto& l : infinite.lights) l.radius = kInfinity<float>;
     struct Variant {

@@ -64,7 +64,7 @@ TEST_SUITE("core") {
         CHECK_THROWS_AS(Image(0, 10), std::invalid_argument);
         CHECK_THROWS_AS(Image(10, -1), std::invalid_argument);
     }
-    TEST_CASE("heat map: viridis from dark violet to yellow, counts on a log scale, a labelled bar") {
+    TEST_CASE("heat map: viridis from dark violet to yellow with counts on a log scale and a labelled bar") {
         // matplotlib's viridis at 0 and 1 (sRGB 68,1,84 and 253,231,37), in linear RGB.
         CHECK(encodeSrgb8(viridis(0.0).x) == 68);
         CHECK(encodeSrgb8(viridis(0.0).z) == 84);
@@ -331,7 +331,7 @@ TEST_SUITE("renderer") {
         CHECK(control.rowsDone == 0);
         CHECK_NOTHROW(checkCancelled(nullptr));
     }
-    TEST_CASE("view render: coarse passes first, the full size last, a stop within a row") {
+    TEST_CASE("view render: coarse passes first and the full size last with a stop within a row") {
         ViewRender view;
         std::vector<int> widths;
         std::mutex widthsMutex;

@@ -133,11 +133,11 @@ Vec3 parseVec3(const std::string& text, const std::string& flag) {
         size_t comma = rest.find(',');
         std::string field = i < 2 ? rest.substr(0, comma) : rest;
         if ((i < 2 && comma == std::string::npos) || field.empty())
-            throw InputError(flag + ": expected X,Y,Z, got '" + printable(text) + "'");
+            throw UsageError(flag + ": expected X,Y,Z, got '" + printable(text) + "'");
         // from_chars: decimal only, all of the field (std::stof took "0x1p3", leading blanks).
         auto [ptr, ec] = std::from_chars(field.data(), field.data() + field.size(), v[i]);
         if (ec != std::errc() || ptr != field.data() + field.size() || !std::isfinite(v[i]))
-            throw InputError(flag + ": '" + printable(field) + "' is not a finite number");
+            throw UsageError(flag + ": '" + printable(field) + "' is not a finite number");
         if (i < 2) rest = rest.substr(comma + 1);
     }
     return v;
@@ -150,11 +150,11 @@ Camera cameraFromOptions(const CommonOptions& o, const Camera& sceneCamera) {
     if (!o.look.empty()) look = parseVec3(o.look, "--look");
     if (!o.eye.empty() || !o.look.empty()) {
         c.view = look - c.eye;
-        if (isZero(c.view)) throw InputError("--look equals --eye: the view direction is zero");
+        if (isZero(c.view)) throw UsageError("--look equals --eye: the view direction is zero");
     }
     if (!o.up.empty()) {
         c.up = parseVec3(o.up, "--up");
-        if (isZero(c.up)) throw InputError("--up: the up vector is zero");
+        if (isZero(c.up)) throw UsageError("--up: the up vector is zero");
     }
     if (o.fov > 0.0f) c.fovYDegrees = o.fov;
     c.aspect = o.aspect();

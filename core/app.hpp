@@ -51,14 +51,11 @@ void addCommonOptions(CLI::App& app, CommonOptions& options, const std::string& 
 // Parses; a help request prints help and exits 0; a bad flag throws UsageError.
 void parseCommandLine(CLI::App& app, int argc, char** argv);
 
-struct UsageError : std::runtime_error {
-    using std::runtime_error::runtime_error;
-};
 struct ExitRequest {
     int code = 0;
 };
 
-// "X,Y,Z" -> vector; throws InputError naming the flag.
+// "X,Y,Z" -> vector; throws UsageError naming the flag.
 Vec3 parseVec3(const std::string& text, const std::string& flag);
 
 // The scene's camera with --eye/--look/--up/--fov applied (and the image's aspect).

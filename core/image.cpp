@@ -109,6 +109,32 @@ Image Image::readPng(const std::string& path) {
     return image;
 }
 
+size_t markPixels(Image& image, const std::vector<uint8_t>& marked, Vec3 colour) {
+    const int w = image.width(), h = image.height();
+    if (marked.size() != size_t(w) * size_t(h))
+        throw std::invalid_argument("markPixels: one flag per pixel");
+    for (Vec3& p : image.pixels()) {  // grey, darker: the marks stand out on any picture
+        float grey = 0.2126f * p.x + 0.7152f * p.y + 0.0722f * p.z;
+        p = Vec3(0.35f * grey);
+    }
+    const int r = std::max(3, w / 100);
+    size_t count = 0;
+    for (int y = 0; y < h; ++y)
+        for (int x = 0; x < w; ++x) {
+            if (!marked[size_t(y) * size_t(w) + size_t(x)]) continue;
+            ++count;
+            image.at(x, y) = colour;
+            // A ring one pixel thick: the pixels whose distance rounds to r.
+            for (int dy = -r - 1; dy <= r + 1; ++dy)
+                for (int dx = -r - 1; dx <= r + 1; ++dx) {
+                    int d2 = dx * dx + dy * dy, px = x + dx, py = y + dy;
+                    if (d2 < r * r - r || d2 > r * r + r) continue;
+                    if (px >= 0 && py >= 0 && px < w && py < h) image.at(px, py) = colour;
+                }
+        }
+    return count;
+}
+
 ImageDifference compareImages(const Image& a, const Image& b, float threshold) {
     if (a.width() != b.width() || a.height() != b.height())
         throw std::invalid_argument("images differ in size");

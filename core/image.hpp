@@ -49,6 +49,12 @@ struct ImageDifference {
 // Throws std::invalid_argument when the sizes differ.
 ImageDifference compareImages(const Image& a, const Image& b, float threshold = 0.0f);
 
+// Marks pixels so a reader sees even one of them: the picture dimmed to grey, every
+// marked pixel in `colour` with a ring of that colour around it (radius: 1/100 of the
+// width, at least 3 pixels). `marked` holds one flag per pixel, rows top to bottom.
+// Returns the number of marked pixels.
+size_t markPixels(Image& image, const std::vector<uint8_t>& marked, Vec3 colour);
+
 // A PNG's companions: pngStem("a.png") is "a", pngWithSuffix("a.png", "-cull") is
 // "a-cull.png".
 std::string pngStem(const std::string& png);

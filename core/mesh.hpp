@@ -14,9 +14,15 @@
 
 namespace boxes {
 
-// Bad input (files, flags, values): the message is one line that names the problem.
+// Bad input (files and their contents): the message is one line that names the problem.
+// The programs exit with 1 (core/app.hpp's runMain).
 struct InputError : std::runtime_error {
     using std::runtime_error::runtime_error;
+};
+// A bad command line: an unknown flag, or a flag's value that is not one it takes (a
+// malformed X,Y,Z, an unknown scene name, a zero view direction). Exit code 2.
+struct UsageError : InputError {
+    using InputError::InputError;
 };
 
 // User text quoted in such a message: control bytes escaped as \xNN so the message stays

@@ -238,16 +238,32 @@ Vec3 Renderer::pixel(int x, int y, RayCounts& counts) const {
 
 void Renderer::renderRows(Image& image, int rowBegin, int rowEnd, RayCounts& counts) const {
     for (int y = rowBegin; y < rowEnd; ++y)
-        for (int x = 0; x < settings_.width; ++x) image.at(x, y) = pixel(x, y, counts);
+        for (int x = 0; x < settings_.width; ++x) {
+            checkCancelled(settings_.control);  // a slow row stops within a pixel
+            image.at(x, y) = pixel(x, y, counts);
+        }
+}
+
+void checkCancelled(const RenderControl* control) {
+    if (control && control->cancel.load(std::memory_order_relaxed)) throw RenderCancelled();
 }
 
 Image Renderer::render(RayCounts* counts) const {
     Image image(settings_.width, settings_.height);
     int threads = resolveThreads(settings_.threads);
     std::vector<RayCounts> perThread(static_cast<size_t>(threads));
+    RenderControl* control = settings_.control;
+    if (control) {
+        control->rowsDone = 0;
+        control->rows = settings_.height;
+    }
     parallelRows(
         settings_.height, threads,
-        [&](int row, int thread) { renderRows(image, row, row + 1, perThread[size_t(thread)]); },
+        [&](int row, int thread) {
+            checkCancelled(control);  // a thrown stop ends the other threads' rows too
+            renderRows(image, row, row + 1, perThread[size_t(thread)]);
+            if (control) control->rowsDone.fetch_add(1, std::memory_order_relaxed);
+        },
         settings_.progressLabel);
     if (counts)
         for (const RayCounts& c : perThread) *counts += c;

@@ -6,6 +6,7 @@
 
 #include <atomic>
 #include <cstdint>
+#include <exception>
 #include <functional>
 #include <string>
 #include <vector>
@@ -34,6 +35,21 @@ struct AnalysisParts {
     static AnalysisParts none() { return {false, false, false, false}; }
 };
 
+// A render another thread can follow and stop (the window renders on a thread of its own,
+// so it answers keys while a slow image is made): rows finished so far, and a request to
+// stop, which the renderer honours between rows by throwing RenderCancelled.
+struct RenderControl {
+    std::atomic<int> rowsDone{0}, rows{0};
+    std::atomic<bool> cancel{false};
+    double progress() const { return rows > 0 ? double(rowsDone) / double(rows) : 0.0; }
+};
+struct RenderCancelled : std::exception {
+    const char* what() const noexcept override { return "render cancelled"; }
+};
+// Throws RenderCancelled when `control` asks to stop (no-op without a control): for a
+// step's own loop over rows.
+void checkCancelled(const RenderControl* control);
+
 struct RenderSettings {
     int width = 640;
     int height = 480;
@@ -41,9 +57,10 @@ struct RenderSettings {
     int threads = 0;          // 0: every hardware thread
     int samplesPerPixel = 1;  // > 1: stratified jitter within the pixel
     uint64_t seed = 1;
-    AnalysisParts analysis;        // which parts of the scene analysis skip shadow rays
-    bool forceAllEffects = false;  // trace every ray, zero weights too (naive renderer)
-    std::string progressLabel;     // when set, long renders print progress to stderr
+    AnalysisParts analysis;            // which parts of the scene analysis skip shadow rays
+    bool forceAllEffects = false;      // trace every ray, zero weights too (naive renderer)
+    std::string progressLabel;         // when set, long renders print progress to stderr
+    RenderControl* control = nullptr;  // when set: progress per row, and a way to stop
 };
 
 // Which objects can block which light, derived once from the scene.

@@ -264,7 +264,7 @@ Scene makeScene(const std::string& nameOrPath, const SceneOptions& options) {
     else {
         std::string names;
         for (const auto& [n, _] : builtinScenes()) names += (names.empty() ? "" : ", ") + n;
-        throw InputError("unknown scene '" + printable(nameOrPath) + "' (built-in: " + names +
+        throw UsageError("unknown scene '" + printable(nameOrPath) + "' (built-in: " + names +
                          "; or a path ending in .obj)");
     }
     s.camera.aspect = options.aspect;

@@ -7,6 +7,8 @@
 #include <algorithm>
 #include <cmath>
 #include <cstdint>
+#include <cstdio>
+#include <cstdlib>
 #include <stdexcept>
 #include <string>
 #include <utility>
@@ -21,6 +23,7 @@
 #include <backends/imgui_impl_opengl3.h>
 
 namespace boxes {
+static_assert(kPanelFoldKey == SDLK_F1 && kPanelMoveKey == SDLK_F2, "the panel's keys");
 namespace {
 
 // Runs a cleanup action when the scope ends, also while an exception unwinds.
@@ -65,6 +68,7 @@ std::runtime_error noWindow(const std::string& reason) {
     X(void, DeleteTextures, (GLsizei, const GLuint*))                               \
     X(void, DeleteVertexArrays, (GLsizei, const GLuint*))                           \
     X(void, Disable, (GLenum))                                                      \
+    X(void, Finish, ())                                                             \
     X(void, DrawArrays, (GLenum, GLint, GLsizei))                                   \
     X(void, GenTextures, (GLsizei, GLuint*))                                        \
     X(void, GenVertexArrays, (GLsizei, GLuint*))                                    \
@@ -162,10 +166,11 @@ public:
     ImageView& operator=(const ImageView&) = delete;
 
     // Uploads the image (every frame: the step may have changed it in place) and draws it
-    // as large as fits into the framebuffer, centred, keeping its aspect ratio.
-    void draw(const Image& image, int framebufferWidth, int framebufferHeight) {
+    // as large as fits into the area (framebuffer pixels, from the bottom-left corner, as
+    // OpenGL counts), centred, keeping its aspect ratio.
+    void draw(const Image& image, int areaX, int areaY, int areaWidth, int areaHeight) {
         static_assert(sizeof(Vec3) == 3 * sizeof(float), "Image pixels must be packed floats");
-        if (image.empty() || framebufferWidth <= 0 || framebufferHeight <= 0) return;
+        if (image.empty() || areaWidth <= 0 || areaHeight <= 0) return;
         int w = image.width(), h = image.height();
         gl_.ActiveTexture(GL_TEXTURE0);
         gl_.BindTexture(GL_TEXTURE_2D, texture_);
@@ -181,10 +186,10 @@ public:
                               image.pixels().data());
         }
 
-        double scale = std::min(double(framebufferWidth) / w, double(framebufferHeight) / h);
+        double scale = std::min(double(areaWidth) / w, double(areaHeight) / h);
         int quadWidth = std::max(1, int(std::lround(w * scale)));
         int quadHeight = std::max(1, int(std::lround(h * scale)));
-        gl_.Viewport((framebufferWidth - quadWidth) / 2, (framebufferHeight - quadHeight) / 2,
+        gl_.Viewport(areaX + (areaWidth - quadWidth) / 2, areaY + (areaHeight - quadHeight) / 2,
                      quadWidth, quadHeight);
         gl_.Disable(GL_BLEND);
         gl_.Disable(GL_SCISSOR_TEST);
@@ -195,7 +200,6 @@ public:
         gl_.DrawArrays(GL_TRIANGLE_STRIP, 0, 4);
         gl_.BindVertexArray(0);
         gl_.UseProgram(0);
-        gl_.Viewport(0, 0, framebufferWidth, framebufferHeight);
     }
 
 private:
@@ -261,21 +265,65 @@ void writeScreenshot(const Gl& gl, int width, int height, const std::string& pat
     Image::fromRgb8(width, height, flipped.data()).writePng(path);
 }
 
-void drawPanel(const WindowOptions& options, WindowCallbacks& callbacks, const Image& image,
-               double frameSeconds) {
-    ImGui::SetNextWindowPos(ImVec2(10.0f, 10.0f), ImGuiCond_Always);
-    ImGui::SetNextWindowBgAlpha(0.65f);
-    const ImGuiWindowFlags flags = ImGuiWindowFlags_NoDecoration |
-                                   ImGuiWindowFlags_AlwaysAutoResize |
-                                   ImGuiWindowFlags_NoSavedSettings | ImGuiWindowFlags_NoMove |
-                                   ImGuiWindowFlags_NoFocusOnAppearing | ImGuiWindowFlags_NoNav;
+// What the panel takes from the window, in framebuffer pixels: a column on the right, or a
+// line at the top; the picture is drawn in the rest.
+struct PanelArea {
+    int right = 0, top = 0;
+};
+
+// The panel: the step's keys and the window's own, the frame time, a render's progress and
+// the step's lines; beside the picture by default, or over it, or folded to one line.
+PanelArea drawPanel(const WindowOptions& options, const PanelPlacement& placement,
+                    WindowCallbacks& callbacks, const Image& image, double frameSeconds) {
+    const ImGuiIO& io = ImGui::GetIO();
+    const float toPixels = io.DisplayFramebufferScale.x;
+    std::pair<double, std::string> progress{-1.0, ""};
+    if (callbacks.progress) progress = callbacks.progress();
+    ImGuiWindowFlags flags = ImGuiWindowFlags_NoDecoration | ImGuiWindowFlags_NoSavedSettings |
+                             ImGuiWindowFlags_NoMove | ImGuiWindowFlags_NoFocusOnAppearing |
+                             ImGuiWindowFlags_NoNav;
+    PanelArea area;
+    if (placement.folded) {
+        // One line: what the window is, how to unfold the panel, and a render's progress.
+        const float height = ImGui::GetFrameHeightWithSpacing();
+        ImGui::SetNextWindowPos(ImVec2(0.0f, 0.0f), ImGuiCond_Always);
+        if (placement.beside) {
+            ImGui::SetNextWindowSize(ImVec2(io.DisplaySize.x, height), ImGuiCond_Always);
+            area.top = int(std::ceil(height * toPixels));
+        } else {
+            flags |= ImGuiWindowFlags_AlwaysAutoResize;
+            ImGui::SetNextWindowBgAlpha(0.65f);
+        }
+        ImGui::Begin("##boxes_panel", nullptr, flags);
+        ImGui::Text("%s  |  F1 keys and status  |  %.1f ms/frame", options.title.c_str(),
+                    frameSeconds * 1000.0);
+        if (progress.first >= 0.0) {
+            ImGui::SameLine();
+            ImGui::Text("|  %s %3.0f%%", progress.second.c_str(), 100.0 * progress.first);
+        }
+        ImGui::End();
+        return area;
+    }
+    if (placement.beside) {  // a column on the right, the full height
+        const float width = std::clamp(0.3f * io.DisplaySize.x, 250.0f, 380.0f);
+        ImGui::SetNextWindowPos(ImVec2(io.DisplaySize.x - width, 0.0f), ImGuiCond_Always);
+        ImGui::SetNextWindowSize(ImVec2(width, io.DisplaySize.y), ImGuiCond_Always);
+        area.right = int(std::ceil(width * toPixels));
+    } else {
+        ImGui::SetNextWindowPos(ImVec2(10.0f, 10.0f), ImGuiCond_Always);
+        ImGui::SetNextWindowBgAlpha(0.65f);
+        flags |= ImGuiWindowFlags_AlwaysAutoResize;
+    }
     ImGui::Begin("##boxes_panel", nullptr, flags);
+    if (placement.beside) ImGui::PushTextWrapPos(0.0f);  // long lines wrap in the column
     ImGui::TextUnformatted(options.title.c_str());
     ImGui::Text("%.1f ms/frame", frameSeconds * 1000.0);
     if (image.empty())
         ImGui::TextUnformatted("no image");
     else
         ImGui::Text("image %d x %d", image.width(), image.height());
+    if (progress.first >= 0.0)
+        ImGui::ProgressBar(float(progress.first), ImVec2(-1.0f, 0.0f), progress.second.c_str());
     ImGui::Separator();
 
     // SDL_GetKeyName may reuse one buffer between calls, so copy each name.
@@ -284,6 +332,9 @@ void drawPanel(const WindowOptions& options, WindowCallbacks& callbacks, const I
         std::string name = SDL_GetKeyName(binding.key);
         lines.emplace_back(name.empty() ? "?" : name, binding.description);
     }
+    lines.emplace_back("F1", "panel: fold to one line");
+    lines.emplace_back("F2",
+                       placement.beside ? "panel: over the picture" : "panel: beside the picture");
     lines.emplace_back("Esc/Q", "quit");
     float column = 0.0f;
     for (const auto& line : lines)
@@ -299,8 +350,40 @@ void drawPanel(const WindowOptions& options, WindowCallbacks& callbacks, const I
         ImGui::Separator();
         callbacks.panel();
     }
+    if (placement.beside) ImGui::PopTextWrapPos();
     ImGui::End();
+    return area;
 }
+
+// BOXES_WINDOW_LOG=FILE: what the window did and when, in milliseconds since it was
+// created, last on each line: "frame N PROGRESS T", "key NAME T", "quit N T", for the test that
+// checks the first frame comes at once and Escape within a frame (tests/windows_x11.py).
+class WindowLog {
+public:
+    WindowLog() {
+        const char* path = std::getenv("BOXES_WINDOW_LOG");
+        if (path && *path) file_ = std::fopen(path, "w");
+    }
+    ~WindowLog() {
+        if (file_) std::fclose(file_);
+    }
+    WindowLog(const WindowLog&) = delete;
+    WindowLog& operator=(const WindowLog&) = delete;
+    void start() { start_ = SDL_GetPerformanceCounter(); }
+    template <typename... Args>
+    void line(const char* format, Args... args) {
+        if (!file_) return;
+        double ms = 1000.0 * double(SDL_GetPerformanceCounter() - start_) /
+                    double(SDL_GetPerformanceFrequency());
+        std::fprintf(file_, format, args..., ms);
+        std::fputc('\n', file_);
+        std::fflush(file_);
+    }
+
+private:
+    std::FILE* file_ = nullptr;
+    Uint64 start_ = 0;
+};
 
 // Queues a key press and release like the keyboard would, so scripted keys take the
 // same path as real ones (ImGui first, then onKey and the Escape/Q check).
@@ -351,9 +434,12 @@ void runWindow(const WindowOptions& options, WindowCallbacks& callbacks) {
     SDL_GL_SetAttribute(SDL_GL_GREEN_SIZE, 8);
     SDL_GL_SetAttribute(SDL_GL_BLUE_SIZE, 8);
 
+    WindowLog log;
     SDL_Window* window = SDL_CreateWindow(
         options.title.c_str(), SDL_WINDOWPOS_CENTERED, SDL_WINDOWPOS_CENTERED, options.width,
-        options.height, SDL_WINDOW_OPENGL | SDL_WINDOW_RESIZABLE | SDL_WINDOW_ALLOW_HIGHDPI);
+        options.height,
+        // Hidden until its first frame is ready (below): a student never sees it black.
+        SDL_WINDOW_OPENGL | SDL_WINDOW_RESIZABLE | SDL_WINDOW_ALLOW_HIGHDPI | SDL_WINDOW_HIDDEN);
     if (!window) throw noWindow(std::string("SDL: ") + SDL_GetError());
     Defer destroyWindow([window] { SDL_DestroyWindow(window); });
 
@@ -384,8 +470,32 @@ void runWindow(const WindowOptions& options, WindowCallbacks& callbacks) {
         throw noWindow("Dear ImGui's OpenGL 3 backend failed to initialise");
     Defer shutdownImGuiGl([] { ImGui_ImplOpenGL3_Shutdown(); });
 
-    // Escape and Q quit unless the step used the key (e.g. to cancel something).
+    // The first use of each shader and of the panel's font costs a lot (a software OpenGL
+    // compiles them then): done once while the window is hidden, so that once shown it
+    // draws its first frame at once.
+    {
+        PanelPlacement placement = options.panel;
+        ImGui_ImplOpenGL3_NewFrame();
+        ImGui_ImplSDL2_NewFrame();
+        ImGui::NewFrame();
+        Image warmUp(1, 1);
+        drawPanel(options, placement, callbacks, warmUp, 0.0);
+        ImGui::Render();
+        view.draw(warmUp, 0, 0, 1, 1);
+        ImGui_ImplOpenGL3_RenderDrawData(ImGui::GetDrawData());
+        gl.Finish();
+    }
+    SDL_ShowWindow(window);
+    log.start();
+
+    // F1 and F2 place the panel; Escape and Q quit unless the step used the key (e.g. to
+    // cancel something).
+    PanelPlacement placement = options.panel;
     auto pressKey = [&](SDL_Keycode key) {
+        if (key == kPanelFoldKey || key == kPanelMoveKey) {
+            (key == kPanelFoldKey ? placement.folded : placement.beside) ^= true;
+            return false;
+        }
         bool used = callbacks.onKey ? callbacks.onKey(int(key)) : false;
         // A key the window lists must do something: scripted runs (the tests) say so.
         bool listed = std::any_of(callbacks.keys.begin(), callbacks.keys.end(),
@@ -417,6 +527,7 @@ void runWindow(const WindowOptions& options, WindowCallbacks& callbacks) {
                     break;
                 case SDL_KEYDOWN:
                     // Typing into an ImGui widget must not trigger the step's keys.
+                    log.line("key %s %.2f", SDL_GetKeyName(event.key.keysym.sym));
                     if (!io.WantCaptureKeyboard && pressKey(event.key.keysym.sym)) quit = true;
                     break;
                 case SDL_MOUSEMOTION:
@@ -427,6 +538,7 @@ void runWindow(const WindowOptions& options, WindowCallbacks& callbacks) {
                     break;
             }
         }
+        if (quit) log.line("quit %d %.2f", frameIndex);
         const bool lastFrame = quit || (scripted && frameIndex + 1 >= options.scriptedFrames);
         // Closing draws one more frame only when it is needed for the screenshot.
         if (quit && options.screenshotPath.empty()) break;
@@ -449,7 +561,7 @@ void runWindow(const WindowOptions& options, WindowCallbacks& callbacks) {
         ImGui_ImplOpenGL3_NewFrame();
         ImGui_ImplSDL2_NewFrame();
         ImGui::NewFrame();
-        drawPanel(options, callbacks, image, smoothedFrameSeconds);
+        PanelArea panel = drawPanel(options, placement, callbacks, image, smoothedFrameSeconds);
         ImGui::Render();
 
         int framebufferWidth = 0, framebufferHeight = 0;
@@ -457,15 +569,21 @@ void runWindow(const WindowOptions& options, WindowCallbacks& callbacks) {
         gl.Viewport(0, 0, framebufferWidth, framebufferHeight);
         gl.ClearColor(0.08f, 0.08f, 0.08f, 1.0f);
         gl.Clear(GL_COLOR_BUFFER_BIT);
-        view.draw(image, framebufferWidth, framebufferHeight);
+        // The picture in what the panel leaves of the window (OpenGL counts rows from the
+        // bottom, so a line at the top shortens the area without moving its origin).
+        view.draw(image, 0, 0, framebufferWidth - panel.right, framebufferHeight - panel.top);
         ImGui_ImplOpenGL3_RenderDrawData(ImGui::GetDrawData());
 
         if (lastFrame && !options.screenshotPath.empty() && framebufferWidth > 0 &&
             framebufferHeight > 0)
             writeScreenshot(gl, framebufferWidth, framebufferHeight, options.screenshotPath);
         SDL_GL_SwapWindow(window);
+        log.line("frame %d %.3f %.2f", frameIndex,
+                 callbacks.progress ? callbacks.progress().first : -1.0);
         if (lastFrame) break;
     }
+    if (callbacks.onClose) callbacks.onClose();
+    log.line("closed %.2f");
 }
 
 }  // namespace boxes

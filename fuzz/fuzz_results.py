@@ -5,10 +5,8 @@ usage: python3 -m fuzz.fuzz_results SECONDS [--artifacts DIR]   fuzz for SECONDS
        python3 -m fuzz.fuzz_results --replay PATH...             every corpus file once (ctest)
 
 The functions: tools/grading/exercises.py case_results (doctest's XML results, from a file as
-the grader and the tour's report read them, and from a string), and tools/grading/build_and_run.py
-list_cases
-(the XML of --list-test-cases, read from the test program's stdout; its sandbox run is
-replaced by one whose stdout is the input, as raw bytes).
+the grader and the tour's report read them, and from a string), and tools/grading/judge
+listed_cases (the XML of a checker's --list-test-cases, from its stdout as raw bytes).
 
 Inputs: Hypothesis draws a seed (a file of fuzz/corpus/results/: real doctest output and
 the malformed ones found, or a built-in generated one) and mutates it (truncation, spliced
@@ -16,8 +14,8 @@ bytes, attribute values of any text or type, repeated and nested elements, entit
 encodings), or writes doctest-like XML from scratch.
 
 Promises, whatever the input: case_results returns a list of CaseResult (str suite and
-name, bool passed, a one-line message, empty when passed) within 30 s; list_cases returns
-[(suite, name)] or raises RuntimeError (its documented error). A broken promise is saved
+name, bool passed, a one-line message, empty when passed) within 30 s; listed_cases returns
+[(suite, name, file)] or raises JudgeError (its documented error). A broken promise is saved
 as DIR/crash-SHA1 (a hang as timeout-SHA1) and the exit status is 1; copy it into the
 corpus with the fix. Before each input the input is also written to DIR/current, so a
 crash of the interpreter itself leaves it behind (fuzz/fuzz.sh keeps it).
@@ -33,10 +31,10 @@ from tools import ROOT
 from tools.grading import exercises
 
 try:
-    from tools.grading import box, build_and_run, sandbox
+    from tools.grading import judge
 except Exception as e:  # a starter kit has no grader: fuzz what exists
-    build_and_run = None
-    print(f"fuzz_results: tools/grading/build_and_run.py not imported ({e}); list_cases not fuzzed", file=sys.stderr)
+    judge = None
+    print(f"fuzz_results: tools/grading/judge not imported ({e}); listed_cases not fuzzed", file=sys.stderr)
 
 CORPUS = os.path.join(ROOT, "fuzz", "corpus", "results")
 TIME_LIMIT = 30.0  # seconds per input: longer is a hang, as in fuzz/fuzz.sh
@@ -109,40 +107,22 @@ def _check_cases(results, how):
             raise BrokenPromise(f"case_results({how}): a passed case with a message")
 
 
-class _FakeSandboxRun:
-    """sandbox.run for list_cases: the test program 'prints' the input (raw bytes, as
-    the sandbox returns them) and exits 0."""
-
-    def __init__(self, data):
-        self.data = data
-
-    def __call__(self, cmd, limits, **kwargs):
-        return sandbox.Result("ok", "ok", 0, self.data, b"", 0.0)
-
-
 def _check_list(data, workdir):
-    if build_and_run is None:
+    if judge is None:
         return
-    real = sandbox.run
-    sandbox.run = _FakeSandboxRun(data)
-    limits = sandbox.Limits()
-    iso = box.Isolation(False, limits, limits)
     try:
-        cases = build_and_run.list_cases(os.path.join(workdir, "build", "tests", "test_program"), iso,
-                                         os.path.join(workdir, "list"))
-    except RuntimeError:
+        cases = judge.listed_cases(data)
+    except judge.JudgeError:
         return
-    finally:
-        sandbox.run = real
     if not isinstance(cases, list) or not all(
-            isinstance(c, tuple) and len(c) == 2 and all(isinstance(x, str) for x in c) for c in cases):
-        raise BrokenPromise("list_cases returned something else than [(suite, name)]")
+            isinstance(c, tuple) and len(c) == 3 and all(isinstance(x, str) for x in c) for c in cases):
+        raise BrokenPromise("listed_cases returned something else than [(suite, name, file)]")
 
 
 def check(data, workdir):
-    """Runs one input through every reader; raises BrokenPromise or Hang. list_cases reads
-    a pipe without a size limit (the grader bounds the output), so it gets only inputs
-    under case_results' limit."""
+    """Runs one input through every reader; raises BrokenPromise or Hang. listed_cases reads
+    a trusted checker's output without a size limit, so it gets only inputs under
+    case_results' limit."""
     path = os.path.join(workdir, "result.xml")
     with open(path, "wb") as f:
         f.write(data)

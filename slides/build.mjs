@@ -17,8 +17,13 @@
 //                                                     caption holds text) of the step's report
 //   <!-- table: 01_triangle/ID|~text|* [columns=a|b] [rows=N] [dense] -->
 //                                                     a measured table (first alternative found)
-//   <!-- plot: 01_triangle/N [w=560] [h=330] -->        the report's plot N, drawn as inline SVG
-//   <!-- fact: 01_triangle/name -->                   one number from the report's facts (also inline)
+//   <!-- plot: 01_triangle/N [w=560] [h=330] -->        the report's plot N (tools/plots.py's SVG, as
+//                                                     on the report page), at most w x h pixels
+//   <!-- fact: 01_triangle/name [| N] -->             one number from the report's facts (also inline;
+//                                                     N: decimals)
+//   <!-- if: 04_bvh_bench --> A <!-- else --> B <!-- end if -->
+//                                                     A when that report exists, else B (may hold
+//                                                     whole slides: a slide that says what ran)
 //   <!-- machine -->                                  the machine the deck's numbers come from
 //   <!-- exercises: 01_triangle -->                  the step's exercise markers as a table
 //   <!-- code: 01_triangle NAME|EXERCISE 1.4 [max=N] [nocomments] -->
@@ -198,110 +203,45 @@ function tableHtml(step, spec, opts, args) {
   );
 }
 
-// A plot spec of the report ({table, x, y, series, logx, logy, title}) drawn as inline SVG:
-// one point per row, one colour per series; on a log axis, zeros sit on a "0" line below.
-function plotHtml(step, spec, opts, args) {
+// The report's plot N (tools/plots.py draws every plot of the tour once, as SVG, for the
+// report page and the decks: one figure, one way of placing its labels). Drawn here when
+// the tour has not drawn them yet (python3 -m tools.plots OUT, once per build).
+let plotsDrawn = false;
+function plotFile(step, index, args) {
+  const file = path.join(args.out, "plots", `${step}-${index}.svg`);
+  if (!fs.existsSync(file) && !plotsDrawn) {
+    plotsDrawn = true;
+    const python = fs.existsSync("/usr/bin/python3") ? "/usr/bin/python3" : "python3"; // Debian's, with matplotlib
+    const run = spawnSync(python, ["-m", "tools.plots", args.out], { cwd: root, encoding: "utf8", timeout: 300000 });
+    if (run.status !== 0) say(`python3 -m tools.plots failed (tools/deps.sh report installs matplotlib): ${(run.stderr || "").trim().split("\n").pop()}`);
+  }
+  return fs.existsSync(file) ? file : null;
+}
+
+function plotHtml(step, spec, opts, args, deckDir) {
   const { report, error } = loadReport(step, args);
   if (!report) return pending(step, "plot", error);
   // spec: an index, or ~text found in the plot's table id or title (alternatives with |).
   const plots = report.plots || [];
-  let plot = null;
+  let index = -1;
   for (const alt of String(spec || "0").split("|")) {
-    if (/^\d+$/.test(alt)) plot = plots[Number(alt)];
-    else if (alt === "pareto") plot = plots.find((p) => p.pareto);
+    if (/^\d+$/.test(alt)) index = Number(alt) < plots.length ? Number(alt) : -1;
+    else if (alt === "pareto") index = plots.findIndex((p) => p.pareto);
     else if (alt.startsWith("~")) {
       const t = alt.slice(1).toLowerCase();
-      plot = plots.find((p) => String(p.table).toLowerCase().includes(t) || String(p.title || "").toLowerCase().includes(t));
+      index = plots.findIndex((p) => String(p.table).toLowerCase().includes(t) || String(p.title || "").toLowerCase().includes(t));
     }
-    if (plot) break;
+    if (index >= 0) break;
   }
-  const table = plot && (report.tables || []).find((t) => t.id === plot.table);
-  if (!table) return `<p class="src">(out/${esc(step)}.json has no plot matching '${esc(spec || "0")}': see its tables.)</p>`;
-  const xi = table.columns.indexOf(plot.x), yi = table.columns.indexOf(plot.y), si = table.columns.indexOf(plot.series);
-  const pts = table.rows
-    .filter((r) => typeof r[xi] === "number" && typeof r[yi] === "number")
-    .map((r) => ({ x: r[xi], y: r[yi], s: si >= 0 ? String(r[si]) : "" }));
-  if (!pts.length) return pending(step, "plot", "no numeric points");
-  const W = Number(opts.w || 560), H = Number(opts.h || 330), R = 16, T = 14, B = 46;
-  const decade = (e) => (e >= -3 && e <= 6 ? (10 ** e).toLocaleString("en-US", { maximumFractionDigits: 3 }) : `1e${e}`);
-  const axis = (vals, log, lo, hi) => {
-    if (log) {
-      const pos = vals.filter((v) => v > 0);
-      const a = Math.floor(Math.log10(pos.length ? Math.min(...pos) : 1)), b = Math.ceil(Math.log10(pos.length ? Math.max(...pos) : 10));
-      const hasZero = vals.some((v) => v <= 0);
-      const from = hasZero ? a - 1 : a, to = Math.max(b, a + 1);
-      const map = (v) => lo + ((v > 0 ? Math.log10(v) : from) - from) / (to - from) * (hi - lo);
-      const ticks = [];
-      for (let e = from; e <= to; ++e) ticks.push({ v: hasZero && e === from ? 0 : 10 ** e, label: hasZero && e === from ? "0" : decade(e) });
-      return { map, ticks };
-    }
-    let a = Math.min(0, ...vals), b = Math.max(...vals);
-    if (b <= a) b = a + 1;
-    const step10 = 10 ** Math.floor(Math.log10((b - a) / 4));
-    const stepv = [1, 2, 5, 10].map((m) => m * step10).find((s2) => (b - a) / s2 <= 6);
-    b = Math.ceil(b / stepv) * stepv;
-    const ticks = [];
-    for (let v = a; v <= b + stepv / 2; v += stepv) ticks.push({ v, label: fmt(Number(v.toPrecision(6))) });
-    return { map: (v) => lo + (v - a) / (b - a) * (hi - lo), ticks };
-  };
-  // The left margin fits the longest y tick label and the rotated axis title.
-  const L = 34 + 7 * Math.max(...axis(pts.map((p) => p.y), !!plot.logy, 0, 1).ticks.map((t) => t.label.length));
-  const ax = axis(pts.map((p) => p.x), !!plot.logx, L, W - R);
-  const ay = axis(pts.map((p) => p.y), !!plot.logy, H - B, T);
-  const colours = ["#0969da", "#cf222e", "#1a7f37", "#8250df", "#9a6700", "#bc4c00", "#57606a", "#e85aad"];
-  const series = [...new Set(pts.map((p) => p.s))];
-  const labelPoints = series.length === pts.length && series.every(Boolean);
-  const el = [];
-  el.push(`<rect x="${L}" y="${T}" width="${W - L - R}" height="${H - T - B}" fill="none" stroke="#d1d9e0"/>`);
-  for (const t of ax.ticks) {
-    const x = ax.map(t.v).toFixed(1);
-    el.push(`<line x1="${x}" y1="${T}" x2="${x}" y2="${H - B}" stroke="#eaeef2"/><text x="${x}" y="${H - B + 16}" text-anchor="middle">${esc(t.label)}</text>`);
-  }
-  for (const t of ay.ticks) {
-    const y = ay.map(t.v).toFixed(1);
-    el.push(`<line x1="${L}" y1="${y}" x2="${W - R}" y2="${y}" stroke="#eaeef2"/><text x="${L - 6}" y="${y}" text-anchor="end" dominant-baseline="middle">${esc(t.label)}</text>`);
-  }
-  el.push(`<text x="${(L + W - R) / 2}" y="${H - 8}" text-anchor="middle">${esc(plot.x)}</text>`);
-  el.push(`<text x="14" y="${(T + H - B) / 2}" text-anchor="middle" transform="rotate(-90 14 ${(T + H - B) / 2})">${esc(plot.y)}</text>`);
-  // The Pareto front (smaller is better on both axes): a staircase through the points no
-  // other beats on both; the rest get a grey ring, never worth it.
-  const front = [];
-  if (plot.pareto) {
-    for (const p of [...pts].sort((a, b) => a.x - b.x || a.y - b.y)) if (!front.length || p.y < front[front.length - 1].y) front.push(p);
-    const xy = [];
-    front.forEach((p, i) => {
-      if (i) xy.push([ax.map(p.x), ay.map(front[i - 1].y)]);
-      xy.push([ax.map(p.x), ay.map(p.y)]);
-    });
-    el.push(`<polyline points="${xy.map(([x, y]) => `${x.toFixed(1)},${y.toFixed(1)}`).join(" ")}" fill="none" stroke="#57606a" stroke-width="1.5" opacity="0.7"/>`);
-    for (const p of pts) {
-      if (front.some((f) => f.x === p.x && f.y === p.y)) continue;
-      el.push(`<circle cx="${ax.map(p.x).toFixed(1)}" cy="${ay.map(p.y).toFixed(1)}" r="9" fill="none" stroke="#8c959f" stroke-width="1.5"/>`);
-    }
-  }
-  const placed = [];
-  pts.forEach((p) => {
-    const c = colours[series.indexOf(p.s) % colours.length];
-    const x = ax.map(p.x), y = ay.map(p.y);
-    el.push(`<circle cx="${x.toFixed(1)}" cy="${y.toFixed(1)}" r="5" fill="${c}"/>`);
-    // One point per series (accuracy-against-time tables): name it beside the point.
-    if (labelPoints) {
-      // Try right-above, left-above, right-below, left-below; keep the first free, in frame.
-      const w = p.s.length * 6.6, h = 13;
-      const spots = [[x + 8, y - 7 - h], [x - 8 - w, y - 7 - h], [x + 8, y + 7], [x - 8 - w, y + 7]];
-      const inFrame = ([lx, ly]) => lx >= L && lx + w <= W && ly >= 0 && ly + h <= H;
-      const free = ([lx, ly]) => placed.every(([px, py, pw]) => lx + w < px || px + pw < lx || ly + h < py || py + h < ly);
-      const spot = spots.find((q) => inFrame(q) && free(q)) || spots.find(inFrame) || spots[0];
-      placed.push([spot[0], spot[1], w]);
-      el.push(`<text x="${spot[0].toFixed(1)}" y="${(spot[1] + h - 2).toFixed(1)}" fill="${c}">${esc(p.s)}</text>`);
-    }
-  });
-  let legend = labelPoints ? "" : series.filter(Boolean).map((name, i) => `<span style="color:${colours[i % colours.length]}">●</span> ${esc(name)}`).join(" &nbsp; ");
-  if (plot.pareto) legend += `${legend ? " &nbsp; " : ""}<span style="color:#57606a">—</span> Pareto front &nbsp; <span style="color:#8c959f">○</span> never worth it (another is better on both)`;
-  return (
-    `<div class="figure plot"><svg xmlns="http://www.w3.org/2000/svg" width="${W}" height="${H}" viewBox="0 0 ${W} ${H}" font-size="12" font-family="sans-serif" fill="#1f2328">${el.join("")}</svg>` +
-    (legend ? `<p class="caption">${legend}</p>` : "") + `</div>`
-  );
+  if (index < 0) return `<p class="src">(out/${esc(step)}.json has no plot matching '${esc(spec || "0")}': see its tables.)</p>`;
+  const file = plotFile(step, index, args);
+  if (!file) return pending(step, "plot", `out/plots/${step}-${index}.svg was not drawn (python3 -m tools.plots; tools/deps.sh report)`);
+  const folder = path.join(deckDir, "images", step);
+  fs.mkdirSync(folder, { recursive: true });
+  fs.copyFileSync(file, path.join(folder, path.basename(file)));
+  const W = Number(opts.w || 560), H = Number(opts.h || 330);
+  const title = plots[index].title || "";
+  return `<div class="figure plot"><img src="images/${esc(step)}/${esc(path.basename(file))}" alt="${esc(title)}" style="max-width:${W}px;max-height:${H}px"></div>`;
 }
 
 function imageHtml(step, spec, opts, args, deckDir) {
@@ -329,10 +269,11 @@ function imageHtml(step, spec, opts, args, deckDir) {
   );
 }
 
-function factText(step, name, args) {
+function factText(step, name, args, decimals) {
   const { report } = loadReport(step, args);
   if (!report || !report.facts || !(name in report.facts)) return `<span class="pending">(${esc(name)}: not measured yet)</span>`;
-  return esc(fmt(report.facts[name]));
+  const v = report.facts[name];
+  return esc(decimals !== undefined && typeof v === "number" ? v.toFixed(Number(decimals)) : fmt(v));
 }
 
 function machineHtml(step, args) {
@@ -475,8 +416,11 @@ function expand(markdown, deck, args, deckDir) {
   const deckStep = /^\d\d_/.test(deck) ? deck : null;
   // Stated outcomes' checks (slides/claims.mjs reads them) are for the test, not the notes.
   markdown = markdown.replace(/^[ \t]*<!--\s*check:.*?-->[ \t]*\r?\n/gm, "");
+  // What ran decides: "<!-- if: STEP --> A <!-- else --> B <!-- end if -->".
+  markdown = markdown.replace(/<!--\s*if:\s*(\S+)\s*-->([\s\S]*?)(?:<!--\s*else\s*-->([\s\S]*?))?<!--\s*end if\s*-->[ \t]*\r?\n?/g,
+    (_, step, then, otherwise) => (loadReport(step, args).report ? then : otherwise || ""));
   // A fact may stand inside a sentence: "<!-- fact: 02_box/random_rays --> rays".
-  markdown = markdown.replace(/<!--\s*fact:?\s*(\d\d_[A-Za-z0-9_]+)\/(\S+?)\s*-->/g, (_, step, name) => factText(step, name, args));
+  markdown = markdown.replace(/<!--\s*fact:?\s*(\d\d_[A-Za-z0-9_]+)\/(\S+?)(?:\s*\|\s*(\d+))?\s*-->/g, (_, step, name, decimals) => factText(step, name, args, decimals));
   return markdown.replace(/^[ \t]*<!--\s*(image|table|plot|fact|machine|code|exercises):?\s*(.*?)\s*-->[ \t]*$/gm, (_, kind, rest) => {
     const words = [...rest.matchAll(/(\w+)="([^"]*)"|(\S+)/g)].map((m) => (m[3] !== undefined ? m[3] : `${m[1]}=${m[2]}`));
     if (kind === "machine") return machineHtml(deckStep, args);
@@ -504,7 +448,7 @@ function expand(markdown, deck, args, deckDir) {
       const last = targets[targets.length - 1].split("/");
       return tableHtml(last[0], last[1] || "*", opts, args);
     }
-    if (kind === "plot") return plotHtml(step, spec, opts, args);
+    if (kind === "plot") return plotHtml(step, spec, opts, args, deckDir);
     return factText(step, spec, args);
   });
 }
@@ -579,7 +523,7 @@ function main() {
       if (!report) notes.push(`not built yet: ${error}`);
       else if (!(report.tables || []).length) notes.push("no measurements in its report");
     }
-    decks.push({ name, title: title(source, name), slides: countSlides(source), notes });
+    decks.push({ name, title: title(source, name), slides: countSlides(built), notes });
   }
   const files = decks.map((d) => path.join(deckDir, `${d.name}.md`));
   const started = Date.now();

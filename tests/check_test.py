@@ -42,7 +42,7 @@ from tools.grading.exercises import exercises
 from tools.grading.kit import strip_solutions, write_kit
 from tools.grading.mutants import git_apply, read_mutant
 from tools import pictures
-from tools.pictures import HEIGHT, MARK, WIDTH, render_references
+from tools.pictures import HEIGHT, MARK, TOLERANCE, WIDTH, render_references
 
 EXERCISE = "1.4"
 MISTAKE = os.path.join(ROOT, "tests", "mutants", "1.4-no-uv-sum-rejection.patch")
@@ -103,13 +103,24 @@ def solve(kit, exercise):
 
 
 def marked(composite):
-    """Magenta pixels in the third panel of check's picture (yours | reference | difference)."""
+    """Reads check's picture (a strip of names over yours | reference | differences): its
+    size, the pixels where the first two panels differ beyond the tolerance, and whether
+    the third panel marks exactly those: each one magenta, and no magenta at all when none
+    differ (the rings around a marked pixel are magenta too, so they are not counted)."""
     w, h, rows = png.read(composite)
     gap = (w - 3 * WIDTH) // 2
-    start = 2 * (WIDTH + gap)
+    body = rows[h - HEIGHT :]
     mark = bytes(MARK)
-    return (w, h), sum(row[3 * x : 3 * x + 3] == mark for row in rows
-                       for x in range(start, start + WIDTH))
+
+    def pixel(panel, x, y):
+        i = 3 * (panel * (WIDTH + gap) + x)
+        return body[y][i : i + 3]
+
+    differ = [(x, y) for y in range(HEIGHT) for x in range(WIDTH)
+              if max(abs(a - b) for a, b in zip(pixel(0, x, y), pixel(1, x, y))) > TOLERANCE]
+    magenta = sum(pixel(2, x, y) == mark for y in range(HEIGHT) for x in range(WIDTH))
+    marks_them = all(pixel(2, x, y) == mark for x, y in differ) and (magenta > 0) == bool(differ)
+    return (w, h), len(differ), marks_them
 
 
 def built_outputs(kit):
@@ -212,8 +223,9 @@ def case_correct(kit, exercise):
     rc, out = run_check(kit, exercise.id)
     check(rc == 0 and "passed" in row(out, exercise.id), f"correct {exercise.id}: check {exercise.id} passes")
     pic = os.path.join(kit, "out", "check", f"{exercise.id}.png")
-    check(os.path.isfile(pic) and marked(pic) == ((3 * WIDTH + 8, HEIGHT), 0),
-          f"correct {exercise.id}: out/check/{exercise.id}.png has no pixel marked")
+    size, count, marks_them = marked(pic) if os.path.isfile(pic) else (None, -1, False)
+    check(size is not None and size[0] > 3 * WIDTH and size[1] > HEIGHT and count == 0 and marks_them,
+          f"correct {exercise.id}: out/check/{exercise.id}.png has no pixel marked (size {size}, {count} differ)")
 
 
 def case_wrong(kit, exercise):
@@ -229,9 +241,10 @@ def case_wrong(kit, exercise):
     m = re.search(r"(\d+) of (\d+) pixels differ from the reference", out)
     said = int(m.group(1)) if m else 0
     pic = os.path.join(kit, "out", "check", f"{exercise.id}.png")
-    size, count = marked(pic) if os.path.isfile(pic) else (None, -1)
-    check(said > 0 and count == said,
-          f"wrong {exercise.id}: out/check/{exercise.id}.png marks the extra pixels ({count} marked, {said} said)")
+    size, count, marks_them = marked(pic) if os.path.isfile(pic) else (None, -1, False)
+    check(said > 0 and count == said and marks_them,
+          f"wrong {exercise.id}: out/check/{exercise.id}.png marks the extra pixels ({count} differ in its panels, "
+          f"{said} said, each marked: {marks_them})")
 
 
 def case_watch(kit, exercise, correct_text, poll):

@@ -494,7 +494,7 @@ def expect_points(doc, label, failing=None, reason=""):
 
 def scenario_gradescope_read(work):
     """Reads the solutions (the bundle's reference tree), the hidden tests (the bundle's and
-    the grading tree's copies) and the results, and throws what it found."""
+    the judge's copies) and the results, and throws what it found."""
     if os.geteuid() != 0:
         return SKIPPED
     root = layout_root(work)
@@ -502,7 +502,7 @@ def scenario_gradescope_read(work):
     first = [e for e in exercises(ROOT) if f"{e.step:02d}" == first_step()][0]
     paths = [os.path.join(root, "source", "workbook", first.path),
              os.path.join(root, "source", "hidden", f"step{first_step()}_extra.cpp"),
-             os.path.join(w0, "src", "tests", "hidden", f"step{first_step()}_0.cpp"),
+             os.path.join(w0, "judge", "src", "tests", "hidden", f"step{first_step()}_0.cpp"),
              os.path.join(root, "source", "workbook", "tools", "grading", "grade.py"),
              os.path.join(root, "submission", first.path)]
     listing = ", ".join(json.dumps(p) for p in paths)
@@ -609,17 +609,18 @@ CONTROL = "\\x1b[31mred\\x1b[0m bell\\x07 nul-free \\x01\\x02 del\\x7f nonchar\\
 
 def scenario_gradescope_control(work):
     """Prints control characters (and bytes that are no UTF-8) on stdout and stderr, then
-    ends before doctest writes a result, so its last line of stderr is the reason; then
-    the same tree by ./workbook grade as that user, whose JUnit XML must parse."""
+    throws them: the exception's message is the reason the checker reports (what the worker
+    prints reaches no result); then the same tree by ./workbook grade as that user, whose
+    JUnit XML must parse."""
     if os.geteuid() != 0:
         return SKIPPED
     files, hostile = hostile_files(body=[
         f'std::fputs("{CONTROL}\\n", stdout);',
         f'std::fputs("{CONTROL}\\n", stderr);',
         "std::fflush(nullptr);",
-        "std::_Exit(3);"])
+        f'throw std::runtime_error("{CONTROL}");'])
     doc = gradescope_root_run(work, files, "control")
-    expect_points(doc, "control", hostile, "no test result, exit 3")
+    expect_points(doc, "control", hostile, "threw")
     out = next((t["output"] for t in doc.get("tests", []) if t.get("number") == hostile), "")
     check("\\x1b[31mred" in out and "\\x07" in out, f"control: written out, not raw: {out[-300:]!r}")
     # The grader itself, in the bundle's tree (the one the user cannot read), with JUnit XML.

@@ -5,16 +5,19 @@
 #include <chrono>
 #include <cmath>
 #include <functional>
+#include <mutex>
 #include <stdexcept>
 #include <thread>
 #include <vector>
 
+#include "core/heatmap.hpp"
 #include "core/image.hpp"
 #include "core/mesh.hpp"
 #include "core/render.hpp"
 #include "core/report.hpp"
 #include "core/scene.hpp"
 #include "core/timing.hpp"
+#include "core/view_render.hpp"
 #include "support.hpp"
 
 using namespace boxes;
@@ -60,6 +63,45 @@ TEST_SUITE("core") {
     TEST_CASE("image: zero size is refused") {
         CHECK_THROWS_AS(Image(0, 10), std::invalid_argument);
         CHECK_THROWS_AS(Image(10, -1), std::invalid_argument);
+    }
+    TEST_CASE("heat map: viridis from dark violet to yellow, counts on a log scale, a labelled bar") {
+        // matplotlib's viridis at 0 and 1 (sRGB 68,1,84 and 253,231,37), in linear RGB.
+        CHECK(encodeSrgb8(viridis(0.0).x) == 68);
+        CHECK(encodeSrgb8(viridis(0.0).z) == 84);
+        CHECK(encodeSrgb8(viridis(1.0).x) == 253);
+        CHECK(encodeSrgb8(viridis(1.0).y) == 231);
+        CHECK(viridis(-1.0) == viridis(0.0));
+        for (double t = 0.0; t < 1.0; t += 0.05)  // brighter all the way: green rises
+            CHECK(viridis(t + 0.05).y > viridis(t).y);
+        CHECK(scaleTop(0.0) == 1.0);
+        CHECK(scaleTop(1.0) == 1.0);
+        CHECK(scaleTop(1.5) == 2.0);
+        CHECK(scaleTop(37.0) == 50.0);
+        CHECK(scaleTop(2000.0) == 2000.0);
+        CHECK(scaleTop(71853.9) == 100000.0);
+        std::vector<double> counts(40 * 30, 0.0);
+        counts[0] = 99.0;     // the top-left pixel at the top of a scale to 99
+        counts[41] = 9.0;     // log(10) / log(100): half way
+        Image map = heatMapImage(counts, 40, 30, 99.0, "box tests");
+        REQUIRE(map.width() > 40);
+        REQUIRE(map.height() > 30);
+        int top = 0;  // the map's first row, under the title's line
+        while (top < map.height() && !(map.at(5, top) == viridis(0.0))) ++top;
+        REQUIRE(top > 5);  // room for the title
+        REQUIRE(top + 30 <= map.height());
+        CHECK(map.at(0, top) == viridis(1.0));
+        CHECK(map.at(1, top + 1).y == doctest::Approx(viridis(0.5).y).epsilon(1e-5));
+        CHECK(map.at(5, top + 5) == viridis(0.0));
+        // The bar's top and bottom, and ink (the title, the ticks) in the margins.
+        int inkTitle = 0, inkTicks = 0;
+        for (int y = 0; y < top; ++y)
+            for (int x = 0; x < map.width(); ++x) inkTitle += map.at(x, y) == Vec3(0.0f);
+        for (int y = top; y < map.height(); ++y)
+            for (int x = 40; x < map.width(); ++x) inkTicks += map.at(x, y) == Vec3(0.0f);
+        CHECK(inkTitle > 20);
+        CHECK(inkTicks > 20);
+        CHECK_THROWS_AS(heatMapImage(counts, 41, 30, 99.0, ""), std::invalid_argument);
+        CHECK(textWidth("10") > textWidth("1"));
     }
     TEST_CASE("image: RMSE and max error of a known difference") {
         Image a(2, 1, Vec3(0.5f)), b(2, 1, Vec3(0.5f));
@@ -268,6 +310,78 @@ TEST_SUITE("renderer") {
         s.maxDepth = 0;
         Image without = renderImage(scene, scene.camera, s);
         CHECK(compareImages(with, without).pixelsDiffering > 20);
+    }
+    TEST_CASE("renderer: a control counts the rows done and stops the render when asked") {
+        Scene scene = makeScene("spheres", SceneOptions{test::dataDir(), 4.0f / 3.0f});
+        RenderSettings s;
+        s.width = 40;
+        s.height = 30;
+        RenderControl control;
+        s.control = &control;
+        Image image = renderImage(scene, scene.camera, s);
+        CHECK(control.rowsDone == 30);
+        CHECK(control.rows == 30);
+        CHECK(control.progress() == 1.0);
+        // The same image as without a control.
+        s.control = nullptr;
+        CHECK(compareImages(image, renderImage(scene, scene.camera, s)).pixelsDiffering == 0);
+        control.cancel = true;  // a stop asked for before the first row: no row is rendered
+        s.control = &control;
+        CHECK_THROWS_AS(renderImage(scene, scene.camera, s), RenderCancelled);
+        CHECK(control.rowsDone == 0);
+        CHECK_NOTHROW(checkCancelled(nullptr));
+    }
+    TEST_CASE("view render: coarse passes first, the full size last, a stop within a row") {
+        ViewRender view;
+        std::vector<int> widths;
+        std::mutex widthsMutex;
+        RenderSettings full;
+        full.width = 160;
+        full.height = 120;
+        auto solid = [&](const RenderSettings& s) {
+            {
+                std::lock_guard<std::mutex> lock(widthsMutex);
+                widths.push_back(s.width);
+            }
+            return Image(s.width, s.height, Vec3(0.5f));
+        };
+        view.start(solid, full);
+        // Waits for the passes (no time is asserted: a loaded machine only makes it longer).
+        Image shown;
+        for (int i = 0; i < 6000 && !view.complete(); ++i)
+            std::this_thread::sleep_for(std::chrono::milliseconds(5));
+        REQUIRE(view.complete());
+        view.stop();
+        CHECK(view.take(shown));
+        CHECK(shown.width() == 160);
+        CHECK_FALSE(view.take(shown));  // given once
+        CHECK(widths == std::vector<int>{20, 80, 160});
+        CHECK(view.progress().first < 0.0);  // nothing under way
+
+        // A render that goes on row by row until it is stopped: stop() returns, nothing new.
+        std::atomic<bool> started{false};
+        view.start(
+            [&](const RenderSettings& s) {
+                started = true;
+                for (;;) {
+                    checkCancelled(s.control);
+                    std::this_thread::sleep_for(std::chrono::milliseconds(1));
+                }
+                return Image();
+            },
+            full);
+        while (!started) std::this_thread::sleep_for(std::chrono::milliseconds(1));
+        CHECK(view.busy());
+        CHECK(view.progress().second == "rendering 1/8 size");
+        view.stop();
+        CHECK_FALSE(view.busy());
+        CHECK_FALSE(view.take(shown));
+
+        // What a render throws reaches the window's thread.
+        view.start([](const RenderSettings&) -> Image { throw std::runtime_error("no mesh"); },
+                   full);
+        view.stop();
+        CHECK_THROWS_WITH(view.take(shown), "no mesh");
     }
     TEST_CASE("renderer: a scene with a mesh but no geometry for it is refused") {
         Scene scene;

@@ -638,11 +638,11 @@ TEST_SUITE("program 01") {
                              {"--scene letters.obj", "not a number", 1},
                              {"--scene range.obj", "out of range", 1},
                              {"--scene empty.obj", "empty", 1},
-                             {"--scene nosuchscene", "unknown scene", 1},
+                             {"--scene nosuchscene", "unknown scene", 2},
                              {"--frobnicate", "frobnicate", 2},
                              {"--width 0", "width", 2},
-                             {"--eye 1,2,3 --look 1,2,3", "view direction is zero", 1},
-                             {"--up 0,0,0", "up vector is zero", 1},
-                             {"--eye 1,2", "expected X,Y,Z", 1}});
+                             {"--eye 1,2,3 --look 1,2,3", "view direction is zero", 2},
+                             {"--up 0,0,0", "up vector is zero", 2},
+                             {"--eye 1,2", "expected X,Y,Z", 2}});
     }
 }

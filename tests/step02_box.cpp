@@ -475,10 +475,10 @@ TEST_SUITE("program 02") {
     TEST_CASE("bad input: one clear line and a non-zero exit") {
         test::TempDir dir;
         test::checkBadInput(program, dir,
-                            {{"--scene nosuchscene", "unknown scene", 1},
+                            {{"--scene nosuchscene", "unknown scene", 2},
                              {"--method cubes", "method", 2},
                              {"--frobnicate", "frobnicate", 2},
                              {"--rays-per-box 0", "rays-per-box", 2},
-                             {"--eye 1,2,3 --look 1,2,3", "view direction is zero", 1}});
+                             {"--eye 1,2,3 --look 1,2,3", "view direction is zero", 2}});
     }
 }

@@ -2,6 +2,7 @@
 // case by name, the exact reference on hard rays, the pre-test, and the program.
 #include <cmath>
 #include <limits>
+#include <nlohmann/json.hpp>
 #include <random>
 
 #include "03_aabb/aabb.hpp"
@@ -535,6 +536,25 @@ TEST_SUITE("program 03") {
         CHECK(test::readText(dir.file("r.json")).find("\"pretest_pixels_differing\": 0") !=
               std::string::npos);
         CHECK(run.out.find("conservative (3.7)") != std::string::npos);
+        // The heat maps show the pretest table's frames: each map's mean per ray (summed over
+        // its pixels) is the table's count per ray (summed over the scene's objects).
+        auto report = nlohmann::json::parse(test::readText(dir.file("r.json")));
+        nlohmann::json pretest;
+        for (const auto& t : report["tables"])
+            if (t["id"] == "pretest") pretest = t;
+        REQUIRE(pretest["rows"].size() == 2);
+        const auto& without = pretest["rows"][0];
+        const auto& with = pretest["rows"][1];
+        const auto& facts = report["facts"];
+        CHECK(facts["heat_primitive_tests_per_ray_without"].get<double>() ==
+              doctest::Approx(without[5].get<double>()).epsilon(1e-12));
+        CHECK(facts["heat_primitive_tests_per_ray_with"].get<double>() ==
+              doctest::Approx(with[5].get<double>()).epsilon(1e-12));
+        CHECK(facts["heat_box_tests_per_ray_with"].get<double>() ==
+              doctest::Approx(with[6].get<double>()).epsilon(1e-12));
+        CHECK(with[5].get<double>() < without[5].get<double>());  // the pre-test pays
+        for (const char* map : {"a-heat-without.png", "a-heat-with.png", "a-heat-boxes.png"})
+            CHECK(test::pngSize(dir.file(map)).first > 12 * 8);  // drawn large, with its bar
     }
     TEST_CASE("window: scripted frames with key presses under the offscreen video driver") {
         test::TempDir dir;
@@ -544,7 +564,7 @@ TEST_SUITE("program 03") {
     TEST_CASE("bad input: one clear line and a non-zero exit") {
         test::TempDir dir;
         test::checkBadInput(program, dir,
-                            {{"--scene nosuchscene", "unknown scene", 1},
+                            {{"--scene nosuchscene", "unknown scene", 2},
                              {"--pretest maybe", "pretest", 2},
                              {"--spheres -3", "spheres", 2},
                              {"--frobnicate", "frobnicate", 2},

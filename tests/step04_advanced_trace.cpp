@@ -10,6 +10,7 @@
 #include <cstring>
 #include <filesystem>
 #include <fstream>
+#include <map>
 #include <nlohmann/json.hpp>
 #include <stdexcept>
 #include <thread>
@@ -191,6 +192,28 @@ TEST_SUITE("program 04") {
         test::checkVariantTables(dir.file("r.json"), {"bvh_build", "bvh_trace", "bvh_cracks",
                                                       "bvh_culling", "bvh_tradeoff"});
         test::checkParetoPlot(dir.file("r.json"), "bvh_tradeoff");
+        // One build time per builder: the trade-off's is bvh_build's median.
+        auto report = nlohmann::json::parse(test::readText(dir.file("r.json")));
+        std::map<std::string, nlohmann::json> tables;
+        for (const auto& t : report["tables"]) tables[t["id"]] = t;
+        for (const auto& row : tables["bvh_tradeoff"]["rows"])
+            for (const auto& build : tables["bvh_build"]["rows"])
+                if (build[0] == row[0]) CHECK(row[1] == build[1]);
+        CHECK_FALSE(report["facts"].contains("build_ms"));
+        // The heat maps of a ray's cost: per builder, the mean over the pixels is the
+        // table's count per ray over the same rays.
+        REQUIRE(tables["bvh_cost"]["rows"].size() == 3);
+        for (const auto& row : tables["bvh_cost"]["rows"]) {
+            std::string builder = row[0];
+            INFO(builder);
+            CHECK(row[1] == 32 * 24);
+            CHECK(report["facts"]["heat_box_tests_per_ray_" + builder].get<double>() ==
+                  doctest::Approx(row[2].get<double>()).epsilon(1e-12));
+            CHECK(report["facts"]["heat_triangle_tests_per_ray_" + builder].get<double>() ==
+                  doctest::Approx(row[3].get<double>()).epsilon(1e-12));
+            CHECK(row[2].get<double>() >= 1.0);  // every ray tests the root's box
+            CHECK(test::pngSize(dir.file("a-heat-" + builder + ".png")).first > 2 * 32);
+        }
     }
     TEST_CASE("trace command: hits equal brute force and the JSON line") {
         test::TempDir dir;

@@ -576,11 +576,11 @@ TEST_SUITE("program 05") {
         test::TempDir dir;
         test::checkBadInput(program, dir,
                             {{"--scene missing.obj", "no such file", 1},
-                             {"--scene nosuchscene", "unknown scene", 1},
+                             {"--scene nosuchscene", "unknown scene", 2},
                              {"--frobnicate", "frobnicate", 2},
                              {"--width 0", "width", 2},
                              {"--repeats 0", "repeats", 2},
                              {"--budget-ms 0", "budget", 2},
-                             {"--eye 1,2,3 --look 1,2,3", "view direction is zero", 1}});
+                             {"--eye 1,2,3 --look 1,2,3", "view direction is zero", 2}});
     }
 }

@@ -489,10 +489,10 @@ TEST_SUITE("program 06") {
         test::TempDir dir;
         std::ofstream(dir.file("nan.obj")) << "v 0 0 0\nv 1 nan 0\nv 0 1 0\nf 1 2 3\n";
         test::checkBadInput(program, dir,
-                            {{"--scene sh1 --eye 1,2,3 --look 1,2,3", "view direction is zero", 1},
-                             {"--scene sh1 --near 0", "--near", 1},
-                             {"--scene sh1 --near -2", "--near", 1},
-                             {"--scene sh1 --near 2 --far 1", "--far", 1},
+                            {{"--scene sh1 --eye 1,2,3 --look 1,2,3", "view direction is zero", 2},
+                             {"--scene sh1 --near 0", "--near", 2},
+                             {"--scene sh1 --near -2", "--near", 2},
+                             {"--scene sh1 --near 2 --far 1", "--far", 2},
                              {"--scene sh1 --width 0", "width", 2},
                              {"--scene sh1 --height 0", "height", 2},
                              {"--scene nan.obj", "non-finite", 1},

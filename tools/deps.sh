@@ -38,7 +38,7 @@ pkgs_for() {
   report) echo python3 python3-matplotlib ;;
   watch) echo inotify-tools ;; # ./workbook check --watch (it polls without)
   slides)
-    echo chromium
+    echo chromium python3-matplotlib # the decks' plots are tools/plots.py's, as on the report page
     command -v node >/dev/null 2>&1 || echo nodejs npm # Debian's Node.js only when none is installed
     ;;
   fuzz) echo clang libclang-rt-dev python3-hypothesis ;;

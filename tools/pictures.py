@@ -13,7 +13,7 @@ import shutil
 import subprocess
 import tempfile
 
-from . import png
+from . import label, png
 from .grading.exercises import step_dirs
 
 WIDTH, HEIGHT = 160, 120
@@ -21,6 +21,7 @@ WIDTH, HEIGHT = 160, 120
 # round differently move a channel by a step or two; a wrong hit changes the colour.
 TOLERANCE = 8
 MARK = (255, 0, 255)  # differing pixels, over the reference dimmed
+RING_RADIUS = 4  # pixels: the ring drawn around each differing pixel
 REFERENCE_DIR = os.path.join("tests", "reference", "pictures")
 REFERENCE_JSON = os.path.join("tests", "reference", "pictures.json")
 
@@ -103,27 +104,46 @@ def render(binary, args, out, suffix="", timeout=120):
 
 
 def compare(mine, reference, out):
-    """Writes [mine | reference | differences] to out; returns the differing pixel count."""
+    """Writes [mine | reference | differences] to out, each panel named above it, and
+    returns the differing pixel count. A differing pixel is magenta with a magenta ring
+    around it (a single pixel is easy to miss) on the reference dimmed to grey."""
     w, h, a = png.read(mine)
     rw, rh, b = png.read(reference)
     if (w, h) != (rw, rh):
         raise png.PngError(f"the images differ in size ({w}x{h} and {rw}x{rh})")
-    gap = 4
-    rows, count = [], 0
+    differs = []
+    diff = []
     for y in range(h):
         ra, rb = a[y], b[y]
-        diff = bytearray(3 * w)
+        row = bytearray(3 * w)
         for x in range(w):
             i = 3 * x
             if max(abs(ra[i] - rb[i]), abs(ra[i + 1] - rb[i + 1]), abs(ra[i + 2] - rb[i + 2])) > TOLERANCE:
-                diff[i : i + 3] = bytes(MARK)
-                count += 1
-            else:
-                grey = (int(rb[i]) + rb[i + 1] + rb[i + 2]) // 9  # the reference, dimmed
-                diff[i : i + 3] = bytes((grey, grey, grey))
-        white = b"\xff" * (3 * gap)
-        rows.append(bytearray(ra) + white + bytearray(rb) + white + diff)
-    png.write(out, 3 * w + 2 * gap, h, rows)
+                differs.append((x, y))
+            grey = (int(rb[i]) + rb[i + 1] + rb[i + 2]) // 9  # the reference, dimmed
+            row[i : i + 3] = bytes((grey, grey, grey))
+        diff.append(row)
+    ring = RING_RADIUS
+    for x, y in differs:
+        for dy in range(-ring - 1, ring + 2):
+            for dx in range(-ring - 1, ring + 2):
+                d2 = dx * dx + dy * dy
+                on_ring = ring * ring - ring <= d2 <= ring * ring + ring
+                px, py = x + dx, y + dy
+                if (on_ring or d2 == 0) and 0 <= px < w and 0 <= py < h:
+                    diff[py][3 * px : 3 * px + 3] = bytes(MARK)
+    count = len(differs)
+    gap, strip, scale = 4, 2 * label.GLYPH_H + 8, 2
+    names = ["yours", "reference", f"{count} differ" if count else "none differ"]
+    white = b"\xff" * (3 * gap)
+    rows = [bytearray(b"\xff" * 3 * (3 * w + 2 * gap)) for _ in range(strip)]
+    for k, name in enumerate(names):
+        left = k * (w + gap) + max(0, (w - label.text_width(name, scale)) // 2)
+        colour = MARK if k == 2 and count else (40, 40, 40)
+        label.draw(rows, left, 4, name, colour, scale)
+    for y in range(h):
+        rows.append(bytearray(a[y]) + white + bytearray(b[y]) + white + diff[y])
+    png.write(out, 3 * w + 2 * gap, h + strip, rows)
     return count
 
 
@@ -166,7 +186,7 @@ def make(root, rows, first, out_dir, say, build=os.path.join("build", "release")
         if path:
             dest = os.path.join(out_dir, f"{r['id']}.png")
             shutil.copyfile(path, dest)
-            line = f"{os.path.relpath(dest, root)} ({what}; yours, the reference, differences in magenta): {line}"
+            line = f"{os.path.relpath(dest, root)} ({what}; yours, the reference, differences ringed in magenta): {line}"
         shown[r["id"]] = line
     return shown
 

@@ -1,6 +1,13 @@
-"""Writes out/index.html from the steps' JSON reports (out/NN_name.json), their images, and
-the tests' XML results (out/test_*.xml, doctest's XML reporter): every step's images,
-its measurement tables and plots (matplotlib), and the status of every exercise.
+"""Writes out/index.html, the tour's report page, from the steps' JSON reports
+(out/NN_name.json), their images, the plots (tools/plots.py), the check of what the READMEs
+state against this run (out/claims.json, slides/claims.mjs --json) and the tests' XML
+results (out/test_*.xml, doctest's XML reporter).
+
+Each step's section is a guide: what the step measured and what to conclude (the README's
+summary, with this run's numbers), the README's "What to look for" with each point marked
+as agreeing with this run or not, links to the README, the deck and docs/measuring.md, then
+the images side by side, the plots and tables each with its takeaway (long tables folded),
+and the facts as labelled values with units. The page needs no network.
 
 usage: python3 -m tools.report OUT_DIR   (from the repository root; ./workbook tour runs it)
 """
@@ -8,16 +15,21 @@ import glob
 import html
 import json
 import os
+import re
 import sys
 
-import matplotlib
+from .grading import ROOT
+from .check import classify, parse_cases
+from .grading.exercises import MAX_RESULT_BYTES, exercises as marked_exercises
 
-matplotlib.use("Agg")
-import matplotlib.pyplot as plt  # noqa: E402
-
-from .grading import ROOT  # noqa: E402
-from .check import classify, parse_cases  # noqa: E402
-from .grading.exercises import MAX_RESULT_BYTES, exercises as marked_exercises  # noqa: E402
+FOLD_ROWS = 6  # a table of more rows opens on a click
+MARKS = {  # a "What to look for" point against this run
+    "agree": ("&#10004;", "agrees with this run"),
+    "disagree": ("&#10008;", "disagrees with this run"),
+    "error": ("&#10008;", "its check cannot be read"),
+    "not measured": ("&#8211;", "not measured in this run"),
+    "unchecked": ("&#9675;", "not checked against the numbers"),
+}
 
 
 def exercises():
@@ -39,38 +51,33 @@ def suite_cases(out):
     return by_suite
 
 
-def checked_time(out):
+def _json(path, default):
     try:
-        with open(os.path.join(out, "check", "status.json"), encoding="utf-8") as f:
-            return json.load(f).get("time", "")
-    except (OSError, ValueError, AttributeError):
-        return ""
+        with open(path, encoding="utf-8") as f:
+            return json.load(f)
+    except (OSError, ValueError):
+        return default
+
+
+def checked_time(out):
+    status = _json(os.path.join(out, "check", "status.json"), {})
+    return status.get("time", "") if isinstance(status, dict) else ""
 
 
 def check_status(out):
     """out/check/status.json (written by ./workbook check): {exercise: its entry}."""
+    status = _json(os.path.join(out, "check", "status.json"), {})
     try:
-        with open(os.path.join(out, "check", "status.json"), encoding="utf-8") as f:
-            return {e["id"]: e for e in json.load(f).get("exercises", [])}
-    except (OSError, ValueError, KeyError, TypeError):
+        return {e["id"]: e for e in status.get("exercises", [])}
+    except (AttributeError, KeyError, TypeError):
         return {}
 
 
-def table_html(t):
-    rows = "".join(
-        "<tr>" + "".join((f"<td class=num>{html.escape(fmt(c))}</td>" if isinstance(c, (int, float)) else f"<td>{html.escape(fmt(c))}</td>") for c in r) + "</tr>" for r in t["rows"]
-    )
-    head = "".join(f"<th>{html.escape(c)}</th>" for c in t["columns"])
-    note = f"<p class=note>{html.escape(t['note'])}</p>" if t.get("note") else ""
-    if t.get("time") and t.get("error"):
-        tm = t["time"]
-        note += (f"<p class=note>Time: <i>{html.escape(tm['median'])}</i> (spread "
-                 f"<i>{html.escape(tm['low'])}</i> to <i>{html.escape(tm['high'])}</i>); error: "
-                 f"<i>{html.escape(t['error'])}</i>, against the reference the note states.</p>")
-    return f"<h3>{html.escape(t['title'])}</h3><table><tr>{head}</tr>{rows}</table>{note}"
-
-
 def fmt(c):
+    if isinstance(c, bool):
+        return "yes" if c else "no"
+    if isinstance(c, int):
+        return f"{c:,}"
     if isinstance(c, float):
         if c == 0:
             return "0"
@@ -81,117 +88,193 @@ def fmt(c):
     return str(c)
 
 
-def pareto_front(points):
-    """The points no other point beats on both axes (smaller is better on each): the
-    variants worth having. points: (x, y) pairs; returns them sorted by x."""
-    front = []
-    for p in sorted(set(points)):
-        if not front or p[1] < front[-1][1]:
-            front.append(p)
-    return front
+def inline(text, base):
+    """The README's inline Markdown as HTML: `code`, **bold**, *emphasis*, [links](...) with
+    relative targets taken from `base` (the README's folder, from the page's)."""
+    out, pos = [], 0
+    for m in re.finditer(r"`([^`]+)`|\*\*(.+?)\*\*|\*(.+?)\*|\[([^\]]+)\]\(([^)\s]+)\)", text):
+        out.append(html.escape(text[pos:m.start()]))
+        if m.group(1) is not None:
+            out.append(f"<code>{html.escape(m.group(1))}</code>")
+        elif m.group(2) is not None:
+            out.append(f"<b>{html.escape(m.group(2))}</b>")
+        elif m.group(3) is not None:
+            out.append(f"<i>{html.escape(m.group(3))}</i>")
+        else:
+            target = m.group(5)
+            if not re.match(r"^[a-z]+:|^#", target):
+                target = os.path.normpath(os.path.join(base, target.split("#")[0])) + (
+                    "#" + target.split("#", 1)[1] if "#" in target else "")
+            out.append(f"<a href='{html.escape(target)}'>{html.escape(m.group(4))}</a>")
+        pos = m.end()
+    out.append(html.escape(text[pos:]))
+    return "".join(out)
 
 
-def plot(report, spec, out, name):
-    table = next((t for t in report["tables"] if t["id"] == spec["table"]), None)
-    if table is None:
-        return None
-    cols = table["columns"]
+def anchor(heading):
+    """GitHub's anchor of a Markdown heading: "Step 01: triangles" -> "step-01-triangles"."""
+    return re.sub(r"[^a-z0-9 _-]", "", heading.strip().lower()).replace(" ", "-")
+
+
+def measuring_anchor(program):
+    """docs/measuring.md's section of a step ("## Step 01: ..."), or ""."""
     try:
-        xi, yi = cols.index(spec["x"]), cols.index(spec["y"])
-    except ValueError:
-        return None
-    si = cols.index(spec["series"]) if spec.get("series") in cols else None
-    # "point_label": a column written beside every point (a series' points then differ by
-    # it, e.g. one point per mesh); without it a series of one point is labelled by name.
-    li = cols.index(spec["point_label"]) if spec.get("point_label") in cols else None
-    fig, ax = plt.subplots(figsize=(6.4, 4.0), dpi=100)
-    groups = {}
-    for r in table["rows"]:
-        x, y = r[xi], r[yi]
-        if not isinstance(x, (int, float)) or not isinstance(y, (int, float)):
-            continue
-        key = str(r[si]) if si is not None else ""
-        groups.setdefault(key, []).append((x, y, str(r[li]) if li is not None else ""))
-    # Room around the points, so a label beside the highest or rightmost one is not cut off.
-    ax.margins(x=0.08, y=0.1)
-    # Long names (a whole sentence per variant) only in the legend, not beside their
-    # points, where they ran over each other and out of the figure.
-    names = [key for key in groups if key]
-    short = len(names) <= 6 and all(len(key) <= 24 for key in names)
-    for key, pts in groups.items():
-        pts.sort()
-        style = "o-" if spec.get("lines") else "o"
-        ax.plot([p[0] for p in pts], [p[1] for p in pts], style, label=key or None)
-        if li is not None:
-            for p in pts:
-                ax.annotate(p[2], p[:2], textcoords="offset points", xytext=(4, 3), fontsize=7,
-                            color="#555")
-        elif not spec.get("lines") and len(pts) == 1 and short:
-            ax.annotate(key, pts[0][:2], textcoords="offset points", xytext=(5, 5), fontsize=8)
-
-    def scale(axis, values, log):
-        if not log:
-            return
-        set_scale = ax.set_xscale if axis == "x" else ax.set_yscale
-        if all(v > 0 for v in values):
-            set_scale("log")
-            return
-        # Zeros on a log axis: symlog, linear only below the smallest non-zero magnitude,
-        # so the decades of the data keep their ticks (the default threshold, 1, made the
-        # whole axis of errors below 1 linear, with a tick at each end only).
-        magnitudes = [abs(v) for v in values if v != 0]
-        set_scale("symlog", linthresh=min(magnitudes) if magnitudes else 1.0, linscale=0.5)
-
-    points = [p for g in groups.values() for p in g]
-    if spec.get("pareto"):
-        # The front as a staircase: right of a point and above it nothing is better.
-        front = pareto_front([p[:2] for p in points])
-        xs, ys = [], []
-        for i, (fx, fy) in enumerate(front):
-            if i:
-                xs.append(fx)
-                ys.append(front[i - 1][1])
-            xs.append(fx)
-            ys.append(fy)
-        ax.plot(xs, ys, "-", color="#333", lw=1.2, alpha=0.6, zorder=0, label="Pareto front")
-        on_front = set(front)
-        dominated = [p for p in points if p[:2] not in on_front]
-        if dominated:
-            ax.plot([p[0] for p in dominated], [p[1] for p in dominated], "o", ms=11,
-                    mfc="none", mec="#999", label="never worth it (another is better on both)")
-    scale("x", [p[0] for p in points], spec.get("logx"))
-    scale("y", [p[1] for p in points], spec.get("logy"))
-    if points and not spec.get("logy") and all(p[1] == 0 for p in points):
-        # Every variant exact: the points sit on the zero line at the bottom (the default
-        # range, -0.06 to 0.06, showed errors below zero that no count can have).
-        ax.set_ylim(-0.05, 1.0)
-    ax.set_xlabel(spec["x"])
-    ax.set_ylabel(spec["y"])
-    ax.set_title(spec.get("title", table["title"]), fontsize=10, wrap=True)
-    ax.grid(True, alpha=0.3)
-    if (si is not None and len(groups) > 1) or spec.get("pareto"):  # below the axes
-        ax.legend(fontsize=8, loc="upper left", bbox_to_anchor=(0.0, -0.16), frameon=False,
-                  ncol=2 if short else 1)
-    fig.tight_layout()
-    path = os.path.join(out, name)
-    fig.savefig(path, bbox_inches="tight")  # with a legend below the axes
-    plt.close(fig)
-    return os.path.basename(path)
+        with open(os.path.join(ROOT, "docs", "measuring.md"), encoding="utf-8") as f:
+            for line in f:
+                if line.startswith(f"## Step {program[:2]}"):
+                    return "#" + anchor(line[3:])
+    except OSError:
+        pass
+    return ""
 
 
-def main():
-    out = sys.argv[1] if len(sys.argv) > 1 else "out"
-    reports = []
-    for path in sorted(glob.glob(os.path.join(out, "[0-9][0-9]_*.json"))):
-        with open(path, encoding="utf-8") as f:
-            reports.append(json.load(f))
+# Facts: a label and a unit from the key's own words (render_ms: "render: 890.4 ms"), so a
+# new fact reads right without an entry here; these read better in words of their own.
+FACT_LABELS = {
+    "rays": "rays traced for the image",
+    "render_ms": ("the image's render time", "ms"),
+    "pixels_disagreeing": "pixels where the methods disagree",
+    "pretest_pixels_differing": "pixels that differ with and without the pre-test",
+    "nodes": "nodes in the image's tree",
+    "sah_cost": "SAH cost of the image's tree",
+    "build_ms": ("one build of the image's tree", "ms"),
+    "refined_image_bit_identical": "refined image bit-identical to the full render",
+    "refinement_frames": "frames the refinement took",
+    "refinement_budget_ms": ("time budget per refinement frame", "ms"),
+    "total_speedup": ("all optimizations together, against the naive render", "x faster"),
+    "slab_speedup_float": ("slabs against six planes, float", "x faster"),
+}
+UNITS = [("_ns_per_test", "ns per test"), ("_ms", "ms"), ("_ns", "ns"), ("_pct", "%"),
+         ("_speedup", "x faster"), ("_ratio", "x")]
+
+
+def fact_label(key):
+    """(label, unit) of a fact's key."""
+    known = FACT_LABELS.get(key)
+    if isinstance(known, tuple):
+        return known
+    if known:
+        return known, ""
+    for suffix, unit in UNITS:
+        if key.endswith(suffix):
+            return key[: -len(suffix)].replace("_", " "), unit
+    return key.replace("_", " "), ""
+
+
+def facts_html(facts):
+    items = []
+    for key, value in facts.items():
+        label, unit = fact_label(key)
+        shown = fmt(value) + (f" {unit}" if unit and not isinstance(value, bool) else "")
+        items.append(f"<dt>{html.escape(label[:1].upper() + label[1:])}</dt><dd>{html.escape(shown)}</dd>")
+    return f"<dl class=facts>{''.join(items)}</dl>"
+
+
+def takeaway_html(text):
+    if not text:
+        return ""
+    return f"<p class=takeaway><span class=label>Takeaway</span> {text}</p>"
+
+
+def table_html(t, takeaway="", base="."):
+    rows = "".join(
+        "<tr>" + "".join((f"<td class=num>{html.escape(fmt(c))}</td>" if isinstance(c, (int, float)) else f"<td>{html.escape(fmt(c))}</td>") for c in r) + "</tr>" for r in t["rows"]
+    )
+    head = "".join(f"<th>{html.escape(c)}</th>" for c in t["columns"])
+    note = f"<p class=note>{html.escape(t['note'])}</p>" if t.get("note") else ""
+    if t.get("time") and t.get("error"):
+        tm = t["time"]
+        note += (f"<p class=note>Time: <i>{html.escape(tm['median'])}</i> (spread "
+                 f"<i>{html.escape(tm['low'])}</i> to <i>{html.escape(tm['high'])}</i>); error: "
+                 f"<i>{html.escape(t['error'])}</i>, against the reference the note states.</p>")
+    body = f"<table><tr>{head}</tr>{rows}</table>{note}"
+    title = f"{html.escape(t['title'])} <span class=id>({html.escape(t['id'])}, {len(t['rows'])} rows)</span>"
+    take = takeaway_html(inline(takeaway, base) if takeaway else "")
+    opened = " open" if len(t["rows"]) <= FOLD_ROWS else ""
+    return (f"<div class=table data-table='{html.escape(t['id'])}'>"
+            f"<details{opened}><summary>{title}</summary>{body}</details>{take}</div>")
+
+
+def plot_html(out, report, i, spec, takeaway, base):
+    from . import plots  # matplotlib: only where the page has plots
+
+    path = plots.plot_path(out, report["program"], i)
+    if not os.path.exists(path):
+        os.makedirs(os.path.dirname(path), exist_ok=True)
+        if not plots.plot(report, spec, os.path.dirname(path), os.path.basename(path)):
+            return ""
+    rel = os.path.relpath(path, out)
+    title = spec.get("title", "")
+    # The title is in the figure; under it, what to take from it.
+    return (f"<figure class=plot data-plot='{i}'><img src='{html.escape(rel)}' alt='{html.escape(title)}'>"
+            f"<figcaption>{takeaway_html(inline(takeaway, base) if takeaway else '')}</figcaption></figure>")
+
+
+def image_rel(img, out):
+    rel = os.path.relpath(img["path"], out) if os.path.isabs(img["path"]) else os.path.relpath(img["path"], out)
+    if rel.startswith("..") or not os.path.exists(os.path.join(out, rel)):
+        rel = os.path.basename(img["path"])
+    return rel
+
+
+def mark_html(bullet, base):
+    symbol, words = MARKS.get(bullet["status"], MARKS["unchecked"])
+    how = "; ".join(f"{c['expression']}: {c['shown']}" for c in bullet.get("checks", []))
+    title = f"{words}" + (f" ({how})" if how else "")
+    return (f"<li class='point {html.escape(bullet['status'].replace(' ', '-'))}'>"
+            f"<span class=mark title='{html.escape(title)}'>{symbol} <span class=words>{html.escape(words)}</span></span> "
+            f"<span class=text>{inline(bullet['text'], base)}</span></li>")
+
+
+def step_html(out, r, guide, decks):
+    prog = r["program"]
+    readme = os.path.join(ROOT, "steps", prog, "README.md")
+    base = os.path.relpath(os.path.dirname(readme), out)
+    title = prog
+    try:
+        with open(readme, encoding="utf-8") as f:
+            first = f.readline()
+        if first.startswith("# "):
+            title = first[2:].strip()
+    except OSError:
+        pass
+    sec = [f"<h2 id='{html.escape(prog)}'>{html.escape(title)}</h2>"]
+    summary = guide.get("summary")
+    if summary:
+        sec.append(f"<p class=summary>{inline(summary, base)}</p>")
+    else:
+        sec.append("<p class='summary missing'>No summary of this run: its README states none, or "
+                   "the check of the READMEs against this run (slides/claims.mjs, Node.js) did not run.</p>")
+    deck = f"slides/{prog}.html" if prog in decks else os.path.relpath(os.path.join(ROOT, "slides", f"{prog}.md"), out)
+    measuring = os.path.relpath(os.path.join(ROOT, "docs", "measuring.md"), out) + measuring_anchor(prog)
+    sec.append(
+        "<p class=links>"
+        f"<a class=readme href='{html.escape(os.path.relpath(readme, out))}'>the step's README</a> · "
+        f"<a class=deck href='{html.escape(deck)}'>its slides</a> · "
+        f"<a class=measuring href='{html.escape(measuring)}'>how its tables are measured (docs/measuring.md)</a></p>")
+    bullets = guide.get("bullets") or []
+    if bullets:
+        sec.append("<h3>What to look for</h3><ul class=points>" + "".join(mark_html(b, base) for b in bullets) + "</ul>")
+    takeaways = guide.get("takeaways") or {}
+    images = r.get("images", [])
+    if images:
+        sec.append("<div class=gallery>" + "".join(
+            f"<figure><a href='{html.escape(image_rel(img, out))}'><img src='{html.escape(image_rel(img, out))}' "
+            f"alt='{html.escape(img['caption'])}'></a><figcaption>{html.escape(img['caption'])}</figcaption></figure>"
+            for img in images) + "</div>")
+    plots_html = [plot_html(out, r, i, spec, takeaways.get(f"plot {i}", ""), base) for i, spec in enumerate(r.get("plots", []))]
+    if any(plots_html):
+        sec.append("<div class=plots>" + "".join(plots_html) + "</div>")
+    for t in r.get("tables", []):
+        sec.append(table_html(t, takeaways.get(t["id"], ""), base))
+    if r.get("facts"):
+        sec.append("<h3>Facts of this run</h3>" + facts_html(r["facts"]))
+    return "<section class=step>" + "".join(sec) + "</section>"
+
+
+def exercises_html(out):
     by_suite = suite_cases(out)
     checked = check_status(out)
-    parts = []
-    # Every step report names its machine; reports copied together from two machines say so.
-    machines = sorted({r.get("machine", "an unknown machine") for r in reports})
-    machine = " and ".join(machines) if machines else "an unknown machine"
-    # Exercise status, in the words of ./workbook check (not started, needs N.M, ...).
     rows = []
     total = earned = 0
     for ex, title, points, src in exercises():
@@ -215,43 +298,65 @@ def main():
             f"<td>{points}</td><td>{f'{passed}/{len(cases)}' if cases else '-'}</td><td>{html.escape(status)}</td>"
             f"<td><code>{src}</code></td><td>{picture}</td></tr>"
         )
-    parts.append(
-        f"<h2 id=exercises>Exercises: {earned} of {total} points pass</h2>"
-        "<p class=note>The same status as <code>./workbook check</code>; its pictures (yours, the "
-        "reference, the pixels that differ) from its last run, out/check/.</p>"
+    return (
+        f"<section id=exercises><h2>Exercises: {earned} of {total} points pass</h2>"
+        "<details><summary>Every exercise, its tests and its status (the same as <code>./workbook "
+        "check</code>; its pictures, yours beside the reference, from its last run)</summary>"
         "<table><tr><th>exercise</th><th>what</th><th>points</th><th>test cases passed</th>"
-        "<th>status</th><th>source</th><th>check's picture</th></tr>" + "".join(rows) + "</table>"
+        "<th>status</th><th>source</th><th>check's picture</th></tr>" + "".join(rows) + "</table></details></section>"
     )
-    for r in reports:
-        prog = r["program"]
-        sec = [f"<h2 id='{prog}'>Step {html.escape(prog)}</h2>"]
-        for img in r.get("images", []):
-            rel = os.path.relpath(img["path"], out) if os.path.isabs(img["path"]) else os.path.relpath(img["path"], out)
-            if rel.startswith(".."):
-                rel = os.path.basename(img["path"])
-            sec.append(
-                f"<figure><img src='{html.escape(rel)}'><figcaption>{html.escape(img['caption'])}</figcaption></figure>"
-            )
-        for i, spec in enumerate(r.get("plots", [])):
-            name = plot(r, spec, out, f"{prog}-plot{i}.png")
-            if name:
-                sec.append(f"<figure><img src='{name}'><figcaption>{html.escape(spec.get('title', ''))}</figcaption></figure>")
-        for t in r.get("tables", []):
-            sec.append(table_html(t))
-        if r.get("facts"):
-            facts = "".join(f"<li><b>{html.escape(k)}</b>: {html.escape(fmt(v))}</li>" for k, v in r["facts"].items())
-            sec.append(f"<ul class=facts>{facts}</ul>")
-        parts.append("<section>" + "".join(sec) + "</section>")
-    slides = ""
-    if os.path.exists(os.path.join(out, "slides", "index.html")):
-        slides = "<p><a href='slides/index.html'>The slides</a></p>"
-    nav = " | ".join(f"<a href='#{r['program']}'>{r['program']}</a>" for r in reports)
-    page = f"""<!doctype html><html><head><meta charset=utf-8><title>Boxes workbook: the tour</title>
-<style>body{{font-family:sans-serif;max-width:1100px;margin:2em auto;color:#222}}
-table{{border-collapse:collapse;margin:.5em 0;font-size:90%}}td,th{{border:1px solid #ccc;padding:2px 8px;text-align:left}}td.num{{text-align:right}}
-tr.passed td{{background:#e8f6e8}}tr.failed td{{background:#fbe3e3}}tr.notstarted td{{color:#777}}
-figure{{display:inline-block;margin:.5em}}img{{max-width:640px;border:1px solid #ddd}}.note{{color:#666;font-size:85%}}</style></head>
-<body><h1>Boxes workbook: the tour</h1><p>Measured on {html.escape(machine)}. <a href='#exercises'>Exercises</a> | {nav}</p>{slides}
+
+
+STYLE = """body{font-family:sans-serif;max-width:1180px;margin:1.5em auto;padding:0 1em;color:#222;line-height:1.4}
+h2{border-top:3px solid #0072B2;padding-top:.6em;margin-top:2em}
+table{border-collapse:collapse;margin:.5em 0;font-size:88%}td,th{border:1px solid #ccc;padding:2px 8px;text-align:left}td.num{text-align:right}
+tr.passed td{background:#e8f6e8}tr.failed td{background:#fbe3e3}tr.notstarted td{color:#777}
+.summary{font-size:110%;background:#f3f7fb;border-left:4px solid #0072B2;padding:.6em .9em}
+.links a{margin-right:.3em}
+ul.points{list-style:none;padding-left:0}ul.points li{margin:.45em 0;display:flex;gap:.8em}
+.mark{flex:0 0 9.5em;font-size:85%;font-weight:bold;padding-top:.1em}.text{flex:1}
+.agree .mark{color:#1a7f37}.disagree .mark,.error .mark{color:#cf222e}.unchecked .mark,.not-measured .mark{color:#777}
+.gallery,.plots{display:flex;flex-wrap:wrap;gap:12px;align-items:flex-start}
+.gallery figure{margin:0;flex:1 1 300px;max-width:420px}.gallery img{width:100%;border:1px solid #ddd}
+.plots figure{margin:0;flex:1 1 520px;max-width:580px}.plots img{width:100%}
+figcaption{font-size:88%;color:#444}
+.takeaway{margin:.3em 0;font-size:95%}.takeaway .label{background:#0072B2;color:#fff;border-radius:3px;padding:0 5px;font-size:80%;margin-right:.3em}
+div.table{margin:1em 0}summary{cursor:pointer;font-weight:bold}summary .id{font-weight:normal;color:#777;font-size:85%}
+.note{color:#666;font-size:85%}
+dl.facts{display:grid;grid-template-columns:max-content auto;gap:2px 16px;font-size:92%}dl.facts dt{color:#555}dl.facts dd{margin:0;font-weight:bold}
+nav a{margin-right:.6em}"""
+
+
+def main():
+    out = sys.argv[1] if len(sys.argv) > 1 else "out"
+    reports = []
+    for path in sorted(glob.glob(os.path.join(out, "[0-9][0-9]_*.json"))):
+        with open(path, encoding="utf-8") as f:
+            report = json.load(f)
+        if "program" in report and os.path.isdir(os.path.join(ROOT, "steps", report["program"])):
+            reports.append(report)
+    claims = _json(os.path.join(out, "claims.json"), {})
+    guides = claims.get("guides", {}) if isinstance(claims, dict) else {}
+    decks = {os.path.basename(p)[:-5] for p in glob.glob(os.path.join(out, "slides", "*.html"))}
+    # Every step report names its machine; reports copied together from two machines say so.
+    machines = sorted({r.get("machine", "an unknown machine") for r in reports})
+    machine = " and ".join(machines) if machines else "an unknown machine"
+    counts = claims.get("counts") if isinstance(claims, dict) else None
+    checked = ""
+    if counts:
+        checked = (f" What the READMEs and decks state about the measured outcomes: <b>{counts['agree']} "
+                   f"agree</b> with this run, <b>{counts['fail']} do not</b>.")
+    nav = " ".join(f"<a href='#{r['program']}'>{r['program']}</a>" for r in reports)
+    slides = "<a href='slides/index.html'>the slides</a>" if os.path.exists(os.path.join(out, "slides", "index.html")) else ""
+    parts = [step_html(out, r, guides.get(r["program"], {}), decks) for r in reports]
+    page = f"""<!doctype html><html lang=en><head><meta charset=utf-8><title>Boxes workbook: the tour</title>
+<meta name=viewport content="width=device-width, initial-scale=1"><style>{STYLE}</style></head>
+<body><h1>Boxes workbook: the tour</h1>
+<p>Every step run headless with <code>--measure</code> on {html.escape(machine)}. Each step says what it measured and what to
+conclude, marks each point of its README's "What to look for" against this run (&#10004; agrees, &#10008; does not,
+&#9675; not checked against the numbers), then shows its images, plots and tables, each with its takeaway.{checked}</p>
+<nav><a href='#exercises'>exercises</a> {nav} {slides}</nav>
+{exercises_html(out)}
 {''.join(parts)}</body></html>"""
     with open(os.path.join(out, "index.html"), "w", encoding="utf-8") as f:
         f.write(page)

@@ -51,8 +51,8 @@ Table measureTriangleSpeed(const Mesh& mesh, uint64_t seed, int repeats);
 // cracks over every case (from the cracks table).
 Table accuracyVersusTime(const Table& speed, const Table& cracks);
 
-// Marks in magenta the pixels of the camera's image where the three tests see different
-// nearest triangles; returns their count.
+// Rings in magenta, on the image greyed (markPixels), the pixels of the camera's image where
+// the three tests see different nearest triangles; returns their count.
 size_t markDisagreements(const TriangleGrid& grid, const Camera& camera, Image& image, int threads);
 
 // The program's --measure: the disagreement image beside the PNG (FILE-disagree.png), the

@@ -36,8 +36,8 @@ struct Disagreement {
 Disagreement compareMethods(const BoxRaySet& set);
 
 // Pixels whose primary ray finds another box, face or hit/miss with the other method
-// (marked magenta in the image), and the largest relative difference in t where both
-// agree. Six planes need their planes: set.setMethod(SixPlanes) once before.
+// (ringed in magenta on the image greyed, markPixels), and the largest relative difference
+// in t where both agree. Six planes need their planes: set.setMethod(SixPlanes) once before.
 struct PixelComparison {
     long long pixels = 0, differ = 0;
     double maxRelativeT = 0.0;

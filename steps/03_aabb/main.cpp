@@ -74,16 +74,19 @@ int main(int argc, char** argv) {
         measureBoundingBoxes(run, objects, hardRays, measureWidth, measureHeight, report);
     };
 
-    // The window: the view with or without the pre-test, and its tests per ray.
+    // The window: the view with or without the pre-test, its tests per ray, and per pixel.
     ManyObjects::View shown;
-    step.keys = {{SDLK_b, "bounding-box pre-test on / off (off: quarter resolution)"}};
+    int heat = 0;  // the picture, or a heat map of its tests per pixel
+    step.keys = {{SDLK_b, "bounding-box pre-test on / off (off: quarter resolution)"},
+                 {SDLK_h, "heat map: primitive tests / box tests per pixel / the picture"}};
     step.onKey = [&](StepRun&, int key) {
         if (key == SDLK_b) pretest = !pretest;
-        return key == SDLK_b;
+        if (key == SDLK_h) heat = (heat + 1) % 3;
+        return key == SDLK_b || key == SDLK_h;
     };
     step.render = [&](StepRun& run) {
         shown = objects.render(run.camera, run.settings, pretest);
-        return shown.image;
+        return shown.show(heat);
     };
     step.panel = [&](StepRun& run) {
         ImGui::Text("pre-test: %s", pretest ? "on" : "off (quarter resolution)");

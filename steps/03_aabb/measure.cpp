@@ -1,7 +1,10 @@
 #include "03_aabb/measure.hpp"
 
+#include <algorithm>
+#include <cstdio>
 #include <iostream>
 
+#include "core/heatmap.hpp"
 #include "core/render.hpp"
 #include "core/timing.hpp"
 
@@ -155,18 +158,16 @@ PretestResult measurePretest(ManyObjects& objects, const Camera& camera,
         Image image(s.width, s.height);
         std::vector<RayCounts> perThread(size_t(resolveThreads(s.threads)));
         std::vector<double> setMs;
+        // Each pixel's tests counted as it is rendered: the heat maps show these very rays.
+        PixelCosts& costs = pretest ? result.withCosts : result.withoutCosts;
         for (int set = 0; set < kSets && set < s.height; ++set) {
-            int rows = (s.height - set + kSets - 1) / kSets;
+            std::vector<int> rows;
+            for (int y = set; y < s.height; y += kSets) rows.push_back(y);
             Stopwatch watch;
-            parallelRows(
-                rows, s.threads,
-                [&](int i, int thread) {
-                    int y = set + kSets * i;
-                    renderer.renderRows(image, y, y + 1, perThread[size_t(thread)]);
-                },
-                s.progressLabel + ", row set " + std::to_string(set + 1) + " of " +
-                    std::to_string(kSets));
-            setMs.push_back(watch.milliseconds() * double(s.height) / double(rows));
+            renderCountingPixels(renderer, image, costs, perThread, rows,
+                                 s.progressLabel + ", row set " + std::to_string(set + 1) + " of " +
+                                     std::to_string(kSets));
+            setMs.push_back(watch.milliseconds() * double(s.height) / double(rows.size()));
         }
         Timing ms = summarize(setMs);
         RayCounts rays;
@@ -181,6 +182,49 @@ PretestResult measurePretest(ManyObjects& objects, const Camera& camera,
                (long long)(pretest ? result.pixelsDiffering : 0)});
     }
     return result;
+}
+
+void addHeatMaps(const StepRun& run, const PretestResult& p, Report& report) {
+    // Small frames drawn large: each pixel a block, so a room sees it.
+    const int block = std::max(1, 384 / std::max(1, p.withCosts.width));
+    auto upscale = [&](const std::vector<double>& v) {
+        const int w = p.withCosts.width, h = p.withCosts.height;
+        std::vector<double> out(size_t(w * block) * size_t(h * block));
+        for (int y = 0; y < h * block; ++y)
+            for (int x = 0; x < w * block; ++x)
+                out[size_t(y) * size_t(w * block) + size_t(x)] =
+                    v[size_t(y / block) * size_t(w) + size_t(x / block)];
+        return out;
+    };
+    // Primitive tests with and without the pre-test on one scale, so they compare.
+    double largest = 0.0;
+    for (const PixelCosts* c : {&p.withoutCosts, &p.withCosts})
+        for (double v : c->primitiveTests) largest = std::max(largest, v);
+    const double top = scaleTop(largest);
+    struct Map {
+        const char *suffix, *fact, *what;
+        const PixelCosts* costs;
+        bool boxes;
+    };
+    for (const Map& m : {Map{"-heat-without", "heat_primitive_tests_per_ray_without",
+                             "primitive tests per pixel, no pre-test", &p.withoutCosts, false},
+                         Map{"-heat-with", "heat_primitive_tests_per_ray_with",
+                             "primitive tests per pixel, pre-test on", &p.withCosts, false},
+                         Map{"-heat-boxes", "heat_box_tests_per_ray_with",
+                             "box tests per pixel, pre-test on", &p.withCosts, true}}) {
+        const std::vector<double>& v = m.boxes ? m.costs->boxTests : m.costs->primitiveTests;
+        double perRay = m.boxes ? m.costs->boxTestsPerRay() : m.costs->primitiveTestsPerRay();
+        double mapTop = m.boxes ? scaleTop(*std::max_element(v.begin(), v.end())) : top;
+        char title[160];
+        std::snprintf(title, sizeof title, "%s (mean %.1f per ray)", m.what, perRay);
+        std::string png = pngWithSuffix(run.png, m.suffix);
+        heatMapImage(upscale(v), m.costs->width * block, m.costs->height * block, mapTop, title)
+            .writePng(png);
+        report.images.push_back({png, std::string(title) + ", log scale 0 to " +
+                                          std::to_string(int(mapTop)) +
+                                          ": the pretest table's frame, ray for ray"});
+        report.facts[m.fact] = perRay;
+    }
 }
 
 void measureBoundingBoxes(const StepRun& run, ManyObjects& objects, size_t hardRays, int frameWidth,
@@ -203,6 +247,7 @@ void measureBoundingBoxes(const StepRun& run, ManyObjects& objects, size_t hardR
     camera.aspect = float(frameWidth) / float(frameHeight);
     PretestResult p = measurePretest(objects, camera, small);
     report.add(p.table);
+    addHeatMaps(run, p, report);
     report.facts["pretest_pixels_differing"] = p.pixelsDiffering;
     const auto& off = p.table.rows.at(0);
     const auto& on = p.table.rows.at(1);

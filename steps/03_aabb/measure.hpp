@@ -29,9 +29,15 @@ struct PretestResult {
     Table table;
     Image with, without;
     size_t pixelsDiffering = 0;
+    PixelCosts withCosts, withoutCosts;  // each pixel's tests in those same frames
 };
 PretestResult measurePretest(ManyObjects& objects, const Camera& camera,
                              const RenderSettings& settings);
+
+// The heat maps of the pretest table's frames beside the PNG (-heat-without, -heat-with:
+// primitive tests per pixel on one log scale; -heat-boxes: box tests), and their means per
+// ray as facts, which equal the table's counts per ray.
+void addHeatMaps(const StepRun& run, const PretestResult& p, Report& report);
 
 // The program's --measure: the slab tests on `hardRays` hard rays per category, and the
 // scene's frames with and without the pre-test at `frameWidth` x `frameHeight`, with the

@@ -1,13 +1,78 @@
 #include "03_aabb/why_we_care.hpp"
 
 #include <algorithm>
+#include <cstdio>
 #include <numeric>
 #include <random>
+#include <utility>
 
 #include "01_triangle/triangle.hpp"
+#include "core/heatmap.hpp"
 #include "core/mesh.hpp"
+#include "core/render.hpp"
 
 namespace boxes {
+
+namespace {
+thread_local TestCounts::OnThread onThread;
+}
+
+void TestCounts::add(uint64_t boxes, uint64_t primitives) {
+    boxTests.fetch_add(boxes, std::memory_order_relaxed);
+    primitiveTests.fetch_add(primitives, std::memory_order_relaxed);
+    onThread.boxTests += boxes;
+    onThread.primitiveTests += primitives;
+}
+
+TestCounts::OnThread TestCounts::take() {
+    return std::exchange(onThread, OnThread{});
+}
+
+double PixelCosts::boxTestsPerRay() const {
+    double r = std::accumulate(rays.begin(), rays.end(), 0.0);
+    return std::accumulate(boxTests.begin(), boxTests.end(), 0.0) / std::max(1.0, r);
+}
+
+double PixelCosts::primitiveTestsPerRay() const {
+    double r = std::accumulate(rays.begin(), rays.end(), 0.0);
+    return std::accumulate(primitiveTests.begin(), primitiveTests.end(), 0.0) / std::max(1.0, r);
+}
+
+void renderCountingPixels(const Renderer& renderer, Image& image, PixelCosts& costs,
+                          std::vector<RayCounts>& perThread, const std::vector<int>& rows,
+                          const std::string& label) {
+    const int w = image.width(), h = image.height();
+    if (costs.width != w || costs.height != h) {
+        costs = PixelCosts{w, h, {}, {}, {}};
+        for (auto* v : {&costs.boxTests, &costs.primitiveTests, &costs.rays})
+            v->assign(size_t(w) * size_t(h), 0.0);
+    }
+    RenderControl* control = renderer.settings().control;
+    if (control) {
+        control->rowsDone = 0;
+        control->rows = rows.empty() ? h : int(rows.size());
+    }
+    parallelRows(
+        rows.empty() ? h : int(rows.size()), int(perThread.size()),
+        [&](int i, int thread) {
+            checkCancelled(control);
+            int y = rows.empty() ? i : rows[size_t(i)];
+            RayCounts& counts = perThread[size_t(thread)];
+            TestCounts::take();  // what this thread counted before belongs to no pixel
+            for (int x = 0; x < w; ++x) {
+                checkCancelled(control);  // within a pixel: a row here can take long
+                uint64_t before = counts.total();
+                image.at(x, y) = renderer.pixel(x, y, counts);
+                TestCounts::OnThread tests = TestCounts::take();
+                size_t p = size_t(y) * size_t(w) + size_t(x);
+                costs.boxTests[p] = double(tests.boxTests);
+                costs.primitiveTests[p] = double(tests.primitiveTests);
+                costs.rays[p] = double(counts.total() - before);
+            }
+            if (control) control->rowsDone.fetch_add(1, std::memory_order_relaxed);
+        },
+        label);
+}
 
 SphereCloud::SphereCloud(std::vector<SceneSphere> spheres, std::shared_ptr<TestCounts> counts)
     : spheres_(std::move(spheres)), counts_(std::move(counts)) {
@@ -44,8 +109,7 @@ bool SphereCloud::intersect(const Ray& rayIn, SurfaceHit& hit) const {
         ray.tmax = *t;
         found = int(i);
     }
-    counts_->boxTests.fetch_add(boxTests, std::memory_order_relaxed);
-    counts_->primitiveTests.fetch_add(tests, std::memory_order_relaxed);
+    counts_->add(boxTests, tests);
     if (found < 0) return false;
     const Sphere& s = spheres_[size_t(found)].shape;
     hit.t = ray.tmax;
@@ -71,8 +135,7 @@ bool SphereCloud::occluded(const Ray& ray) const {
         ++tests;
         blocked = intersectSphere(ray, spheres_[i].shape).has_value();
     }
-    counts_->boxTests.fetch_add(boxTests, std::memory_order_relaxed);
-    counts_->primitiveTests.fetch_add(tests, std::memory_order_relaxed);
+    counts_->add(boxTests, tests);
     return blocked;
 }
 
@@ -149,8 +212,7 @@ bool TriangleGroups::intersect(const Ray& rayIn, SurfaceHit& hit) const {
             found = t, u = h->u, v = h->v;
         }
     }
-    counts_->boxTests.fetch_add(boxTests, std::memory_order_relaxed);
-    counts_->primitiveTests.fetch_add(tests, std::memory_order_relaxed);
+    counts_->add(boxTests, tests);
     if (found == kNoPrimitive) return false;
     hit = triangleHit(mesh_, found, ray, ray.tmax, u, v, material_);
     return true;
@@ -178,9 +240,19 @@ bool TriangleGroups::occluded(const Ray& ray) const {
                           .has_value();
         }
     }
-    counts_->boxTests.fetch_add(boxTests, std::memory_order_relaxed);
-    counts_->primitiveTests.fetch_add(tests, std::memory_order_relaxed);
+    counts_->add(boxTests, tests);
     return blocked;
+}
+
+Image ManyObjects::View::show(int mode) const {
+    if (mode == 0 || costs.width == 0) return image;
+    const std::vector<double>& v = mode == 1 ? costs.primitiveTests : costs.boxTests;
+    double perRay = mode == 1 ? costs.primitiveTestsPerRay() : costs.boxTestsPerRay();
+    char title[96];
+    std::snprintf(title, sizeof title, "%s tests per pixel (mean %.1f per ray)",
+                  mode == 1 ? "primitive" : "box", perRay);
+    return heatMapImage(v, costs.width, costs.height,
+                        scaleTop(*std::max_element(v.begin(), v.end())), title);
 }
 
 void ManyObjects::setPretest(bool on) {
@@ -196,9 +268,13 @@ ManyObjects::View ManyObjects::render(const Camera& camera, RenderSettings setti
         settings.height = std::max(1, settings.height / 4);
         settings.progressLabel = "03_aabb: without the pre-test";
     }
-    RayCounts rays;
     View view;
-    view.image = renderImage(scene, camera, settings, &rays);
+    view.image = Image(settings.width, settings.height);
+    Renderer renderer(scene, camera, settings);
+    std::vector<RayCounts> perThread(size_t(resolveThreads(settings.threads)));
+    renderCountingPixels(renderer, view.image, view.costs, perThread, {}, settings.progressLabel);
+    RayCounts rays;
+    for (const RayCounts& c : perThread) rays += c;
     double n = double(std::max<uint64_t>(1, rays.total()));
     view.primitiveTestsPerRay = double(counts->primitiveTests.load()) / n;
     view.boxTestsPerRay = double(counts->boxTests.load()) / n;

@@ -5,6 +5,7 @@
 
 #include <atomic>
 #include <memory>
+#include <string>
 #include <vector>
 
 #include "03_aabb/aabb.hpp"
@@ -13,13 +14,20 @@
 
 namespace boxes {
 
-// Tests made by the objects below, summed over every ray (one atomic add per ray and object).
+// Tests made by the objects below, summed over every ray (one atomic add per ray and object),
+// and on the calling thread since its last take (the cost of one pixel, for a heat map).
 struct TestCounts {
     std::atomic<uint64_t> boxTests{0}, primitiveTests{0};
     void reset() {
         boxTests = 0;
         primitiveTests = 0;
     }
+    void add(uint64_t boxes, uint64_t primitives);
+    struct OnThread {
+        uint64_t boxTests = 0, primitiveTests = 0;
+    };
+    // The tests this thread made since its last take, and zero again.
+    static OnThread take();
 };
 
 // Spheres, each with its box (exercise 3.1) tested first when the pre-test is on.
@@ -74,6 +82,22 @@ private:
     bool pretest_ = true;
 };
 
+// What each pixel's rays cost: their box and primitive tests and the rays themselves, rows top
+// to bottom. The means per ray are the sums' ratios (as the pretest table counts them).
+struct PixelCosts {
+    int width = 0, height = 0;
+    std::vector<double> boxTests, primitiveTests, rays;
+    double boxTestsPerRay() const;
+    double primitiveTestsPerRay() const;
+};
+// Renders `image` (its size) with `renderer`, row by row on the render threads, counting each
+// pixel's tests with `counts` (the scene's objects' TestCounts) and its rays; `rows` lists the
+// rows to render (all when empty), the rest of `costs` is left as it is. A control in the
+// renderer's settings stops it between rows.
+void renderCountingPixels(const Renderer& renderer, Image& image, PixelCosts& costs,
+                          std::vector<RayCounts>& perThread, const std::vector<int>& rows = {},
+                          const std::string& label = "");
+
 // The step's scene: a floor, `spheres` small spheres, `triangles` small triangles in
 // clusters of 8, and the bunny (data/meshes/bunny.obj, scaled by 1.5 and set on the floor).
 struct ManyObjects {
@@ -84,10 +108,15 @@ struct ManyObjects {
     void setPretest(bool on);
 
     // The window's view, with the pre-test on or off (off: at a quarter of the size, so a
-    // frame takes seconds rather than minutes), and the tests it made per ray.
+    // frame takes seconds rather than minutes), the tests it made per ray, and per pixel
+    // (every ray of the pixel: primary, shadow, reflected).
     struct View {
         Image image;
         double primitiveTestsPerRay = 0.0, boxTestsPerRay = 0.0;
+        PixelCosts costs;
+        // 0: the picture; 1, 2: a heat map of its primitive, box tests per pixel, with the
+        // mean per ray in its title (core/heatmap.hpp).
+        Image show(int mode) const;
     };
     View render(const Camera& camera, RenderSettings settings, bool pretest);
 };

@@ -32,7 +32,7 @@ BvhBuilder parseBvhBuilder(const std::string& name) {
     for (BvhBuilder b : {BvhBuilder::Midpoint, BvhBuilder::Median, BvhBuilder::BinnedSah,
                          BvhBuilder::SweepSah, BvhBuilder::SpatialSah})
         if (name == bvhBuilderName(b)) return b;
-    throw InputError("unknown builder '" + name +
+    throw UsageError("unknown builder '" + name +
                      "' (use midpoint, median, sah, sweep-sah or sbvh)");
 }
 

@@ -10,6 +10,7 @@
 #include <memory>
 #include <optional>
 
+#include "04_bvh/cost_map.hpp"
 #include "04_bvh/culling_map.hpp"
 #include "04_bvh/measure.hpp"
 #include "04_bvh/trace.hpp"
@@ -59,26 +60,29 @@ int main(int argc, char** argv) {
         if (geometry) addTreeReport(report, run.scene, *geometry, run.png, run.options);
     };
     step.measure = [&](StepRun& run, Report& report) {
-        if (geometry) measureTree(report, run.scene, *geometry, run.options, measure);
+        if (geometry) measureTree(report, run.scene, *geometry, run.options, measure, run.png);
     };
-
     // The window: left the view through the hierarchy, right the hierarchy from above.
     CullingMapWindow map;
-    step.keys = {{SDLK_b, "next builder (midpoint / median / binned SAH), rebuilds"}};
+    bool heat = false;  // the view's tests per pixel instead of the picture and the map
+    step.keys = {{SDLK_b, "next builder (midpoint / median / binned SAH), rebuilds"},
+                 {SDLK_h, "heat map: box and triangle tests per pixel / the picture"}};
     for (const KeyBinding& k : CullingMapWindow::keys()) step.keys.push_back(k);
     step.openWindow = [&](StepRun& run) {
         run.settings.width = std::max(1, run.options.width / 2);
         run.scene.camera.aspect = float(run.settings.width) / float(run.settings.height);
     };
     step.onKey = [&](StepRun& run, int key) {
+        if (key == SDLK_h) return heat = geometry && !heat, true;  // no mesh, no map
         if (key != SDLK_b || !geometry) return map.onKey(key);
         build.builder = BvhBuilder((int(build.builder) + 1) % std::size(kExerciseBuilders));
         geometry = addMeshBvh(run.scene, build);
         return true;
     };
     step.render = [&](StepRun& run) {
+        if (heat) return viewCostMap(geometry->bvh(), run.camera, run.settings, build.builder);
         Image view = renderImage(run.scene, run.camera, run.settings);
-        Image image(run.options.width, run.options.height);
+        Image image(2 * run.settings.width, run.settings.height);
         for (int y = 0; y < view.height(); ++y)
             for (int x = 0; x < view.width(); ++x) image.at(x, y) = view.at(x, y);
         if (geometry)

@@ -28,9 +28,11 @@ struct MeasureSettings {
 void addMeasureOptions(CLI::App& app, MeasureSettings& settings);
 
 // --measure: the tables on the scene's mesh and the program's tree (seed and data folder
-// from `options`), with the crack count on the bunny and sh1, and the plots.
+// from `options`), with the crack count on the bunny and sh1, and the plots; and the heat
+// maps of a ray's cost per builder beside `png` (cost_map.hpp).
 void measureTree(Report& report, const Scene& scene, const MeshBvhGeometry& geometry,
-                 const CommonOptions& options, const MeasureSettings& settings);
+                 const CommonOptions& options, const MeasureSettings& settings,
+                 const std::string& png);
 
 // The engine's subcommands (trace, check, rays: advanced/commands.hpp) added to `app`; the
 // function returned runs the one the command line named, after parsing, and returns its

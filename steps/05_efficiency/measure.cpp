@@ -83,6 +83,7 @@ void measureLab(const Scene& scene, LabBvhMesh* mesh, const LabOptions& o, Repor
          true, true, true);
     plot("float_double", "ns/test", "max rel t error", "variant",
          "Float against double: time per test against the error in t", false, true);
+    report.plots.back()["point_label"] = "offset";  // each point one distance from the origin
     plot("sincos", "ns/call", "max abs error", "variant",
          "Sine: time per call against the largest error over the circle", false, true);
     plot("op_cost", "ns/op", "max rel error", "type",

@@ -18,13 +18,13 @@ void setClipPlanes(RasterSettings& settings, std::optional<double> near,
                    std::optional<double> far) {
     if (near) {
         if (!(*near > 0.0) || !std::isfinite(*near))
-            throw InputError("--near must be greater than 0");
+            throw UsageError("--near must be greater than 0");
         settings.near = *near;
     }
     if (far) {
         if (!(*far > 0.0) || !std::isfinite(*far) ||
             (settings.near > 0.0 && !(*far > settings.near)))
-            throw InputError("--far must be greater than --near (and than 0)");
+            throw UsageError("--far must be greater than --near (and than 0)");
         settings.far = *far;
     }
 }

@@ -11,7 +11,7 @@ from unittest import mock
 from tests.tools import scratch  # noqa: F401  (tempfile's folders go into one removed at exit)
 
 from tools import ROOT
-from tools import check, pictures, png
+from tools import check, label, pictures, png
 from tools.grading.exercises import exercises
 
 
@@ -256,9 +256,31 @@ class Pictures(unittest.TestCase):
             png.write(b, 5, 4, changed)
             self.assertEqual(pictures.compare(b, a, out), 1)
             w, h, composite = png.read(out)
-            self.assertEqual((w, h), (3 * 5 + 8, 4))
+            strip = h - 4  # the panels' names above them
+            self.assertEqual(w, 3 * 5 + 8)
+            self.assertGreater(strip, label.GLYPH_H)
             x = 2 * 5 + 8  # the differences panel
-            self.assertEqual(tuple(composite[1][3 * x : 3 * x + 3]), pictures.MARK)
+            self.assertEqual(tuple(composite[strip + 1][3 * x : 3 * x + 3]), pictures.MARK)
+            ring = x + pictures.RING_RADIUS  # its ring, in the same row
+            self.assertEqual(tuple(composite[strip + 1][3 * ring : 3 * ring + 3]), pictures.MARK)
+
+    def test_the_check_picture_names_its_panels(self):
+        # Wide enough panels for the names: each drawn over its own panel, in ink.
+        with tempfile.TemporaryDirectory() as tmp:
+            a, out = os.path.join(tmp, "a.png"), os.path.join(tmp, "c.png")
+            png.write(a, 120, 10, [bytearray([90, 90, 90] * 120) for _ in range(10)])
+            self.assertEqual(pictures.compare(a, a, out), 0)
+            w, h, composite = png.read(out)
+            strip = h - 10
+            for k in range(3):  # each panel's part of the strip holds ink
+                inked = sum(1 for y in range(strip) for x in range(k * 124, k * 124 + 120)
+                            if composite[y][3 * x] < 128)
+                self.assertGreater(inked, 20, f"panel {k} has no name")
+            words = [bytearray(b"\xff" * 3 * 200) for _ in range(label.GLYPH_H)]
+            label.draw(words, 0, 0, "yours", (0, 0, 0))
+            self.assertEqual(label.text_width("yours"), 29)
+            self.assertTrue(any(b == 0 for row in words for b in row[: 3 * 29]))
+            self.assertFalse(any(b == 0 for row in words for b in row[3 * 29 :]))
 
     def test_not_a_png_is_one_clear_error(self):
         with tempfile.NamedTemporaryFile(suffix=".png") as f:

@@ -15,7 +15,7 @@ from tools.grading import (box, build_and_run, class_bench, errors, grade, grade
                            gradescope, grading_tree, sandbox)
 from tests.tools import test_strict_numbers
 from tools.grading.exercises import CaseResult, Exercise, exercises
-from tools.grading.build_and_run import CaseOutcome, case_outcome
+from tools.grading.build_and_run import CaseOutcome
 from tools.grading.grade_report import exercise_row
 
 
@@ -27,54 +27,9 @@ def result(status="ok", reason=None, stdout=b"", stderr=b"", seconds=0.25, code=
     return sandbox.Result(status, reason or status, code, stdout, stderr, seconds)
 
 
-class CaseOutcomes(unittest.TestCase):
-    def test_passed(self):
-        o = case_outcome("c", result(), [CaseResult("s", "c", True)])
-        self.assertEqual((o.status, o.reason, o.seconds, o.passed), ("passed", "", 0.25, True))
-
-    def test_a_limit_or_a_crash_is_the_reason_whatever_doctest_wrote(self):
-        for status, why in (("time limit", "time limit"), ("crashed", "crashed: SIGSEGV"),
-                            ("memory limit", "memory limit"), ("output limit", "output limit")):
-            o = case_outcome("c", result(status, why), [CaseResult("s", "c", True)])
-            self.assertEqual((o.status, o.reason), (status, why))
-
-    def test_a_failed_check_names_it(self):
-        o = case_outcome("c", result("failed", "failed: exit 1", code=1),
-                         [CaseResult("s", "c", False, "t.cpp:3: CHECK( x == 1 ) is 2 == 1")])
-        self.assertEqual((o.status, o.reason), ("failed", "failed: t.cpp:3: CHECK( x == 1 ) is 2 == 1"))
-        o = case_outcome("c", result("failed", "failed: exit 1"), [CaseResult("s", "c", False, "")])
-        self.assertEqual(o.reason, "failed: the test case failed")
-
-    def test_bad_alloc_caught_by_doctest_is_the_memory_limit(self):
-        o = case_outcome("c", result("failed", "failed: exit 1"),
-                         [CaseResult("s", "c", False, "threw: std::bad_alloc")])
-        self.assertEqual((o.status, o.reason), ("memory limit", "memory limit"))
-
-    def test_passed_then_failed_at_exit(self):
-        o = case_outcome("c", result("failed", "failed: exit 7", code=7), [CaseResult("s", "c", True)])
-        self.assertEqual((o.status, o.reason), ("failed", "failed: the test passed, then the program ended with failed: exit 7"))
-
-    def test_no_result_written(self):
-        o = case_outcome("c", result(stderr=b"first\nlast words\n"), [])
-        self.assertEqual(o.reason, "failed: no test result (it ended before doctest wrote one): last words")
-        o = case_outcome("c", result("failed", "failed: exit 3", code=3), [])
-        self.assertEqual(o.reason, "failed: no test result, exit 3")
-
-
-class ListedCases(unittest.TestCase):
-    def test_the_list(self):
-        xml = (b'<doctest><TestSuite><TestCase name="a" testsuite="exercise 1.1"/>'
-               b'<TestCase name="b, c" testsuite="core"/></TestSuite></doctest>')
-        self.assertEqual(build_and_run.listed_cases(result(stdout=xml)), [("exercise 1.1", "a"), ("core", "b, c")])
-
-    def test_no_list_says_why(self):
-        with self.assertRaises(RuntimeError) as e:
-            build_and_run.listed_cases(result("time limit", stdout=b"spinning"))
-        self.assertEqual(e.exception.args, ("time limit", "time limit (the test program does not list its tests)"))
-        with self.assertRaises(RuntimeError) as e:
-            build_and_run.listed_cases(result("failed", "failed: exit 2", stdout=b"\xff\xfe not xml"))
-        self.assertEqual(e.exception.args, ("failed", "failed: failed: exit 2 (the test program does not list its tests)"))
-
+class DoctestFilters(unittest.TestCase):
+    # How a case ends (judge.verdict) and the checker's list of cases (judge.listed_cases):
+    # tests/tools/test_judge.py.
     def test_doctest_filters_escape_commas(self):
         self.assertEqual(build_and_run.doctest_filter("a, b,c"), "a\\, b\\,c")
 
@@ -155,7 +110,8 @@ class PointsTable(unittest.TestCase):
         self.assertEqual((doc["points"], doc["max"], doc["seconds"], doc["notes"]), (1, 10, 12.35, ["n"]))
         self.assertEqual(doc["exercises"][1], {"exercise": "1.2", "title": "a root", "step": "01", "points": 0,
                                                "max": 2, "status": "failed", "reason": "failed: CHECK( x )",
-                                               "case": "edge", "seconds": 0.75})
+                                               "case": "edge", "details": ["passed: fine", "FAILED: edge: failed: CHECK( x )"],
+                                               "hidden": 0, "seconds": 0.75})
         grade_report.write_junit(os.path.join(folder, "g.xml"), rows, ["n"], 12.3)
         root = ET.parse(os.path.join(folder, "g.xml")).getroot()
         self.assertEqual((root.get("tests"), root.get("failures")), ("4", "3"))
@@ -172,7 +128,8 @@ class PointsTable(unittest.TestCase):
         got = grade_report.results_by_exercise(table_rows())
         self.assertEqual(got[0], {"exercise": "1.1", "title": "a sum", "step": "01", "max": 1, "passed": True,
                                   "points": 1, "status": "passed", "reason": "", "seconds": 1.0,
-                                  "details": ["passed: fine", "passed: fine"]})
+                                  "details": ["passed: fine", "passed: fine"], "hidden": 0,
+                                  "public_details": ["passed: fine", "passed: fine"], "public_passed": True})
         self.assertEqual((got[1]["points"], got[1]["reason"]), (0, "edge: failed: CHECK( x )"))
         self.assertEqual(got[3]["details"], ["does not compile: y.cpp:1: error: no"])
 

@@ -7,10 +7,14 @@ from tests.tools import scratch  # noqa: F401  (tempfile's folders: one, removed
 
 from tools.grading import gradescope
 
+# The grader's rows say how many of an exercise's cases are hidden tests (from the checker's own
+# list: whatever doctest form declared them) and give the other cases' details apart.
 ROWS = [{"exercise": "1.1", "title": "a sum", "max": 1, "points": 1, "passed": True, "status": "passed",
-         "reason": "", "details": ["passed: fine", "passed: hidden: one more"]},
+         "reason": "", "details": ["passed: fine", "passed: one more"], "hidden": 1,
+         "public_details": ["passed: fine"], "public_passed": True},
         {"exercise": "1.2", "title": "a root", "max": 2, "points": 0, "passed": False, "status": "time limit",
-         "reason": "slow: time limit", "details": ["FAILED: slow: time limit"]}]
+         "reason": "slow: time limit", "details": ["FAILED: slow: time limit"], "hidden": 0,
+         "public_details": ["FAILED: slow: time limit"], "public_passed": False}]
 CONFIG = {"steps": ["01"], "hidden_visibility": "after_due_date", "hidden_cases": {"1.1": ["hidden: one more"]}}
 
 
@@ -32,12 +36,13 @@ class ResultsJson(unittest.TestCase):
                          [("1.1", 1, 1, "passed", "after_due_date"), ("1.1.0", 0, 0, "passed", "visible"),
                           ("1.2", 0, 2, "failed", "visible")])
         self.assertEqual(tests[1]["output"], "passed: fine")  # the hidden case is not shown
+        self.assertNotIn("one more", "".join(t["output"] for t in tests if t["visibility"] == "visible"))
         self.assertEqual(tests[2]["output"].split("\n"),
                          ["0 of 2 points: time limit", "first failure: slow: time limit", "FAILED: slow: time limit"])
         self.assertEqual(tests[0]["name"], "exercise 1.1: a sum")
 
     def test_without_hidden_tests_the_total(self):
-        doc = gradescope.results_json(ROWS, dict(CONFIG, hidden_cases={}), [], 3)
+        doc = gradescope.results_json([dict(r, hidden=0) for r in ROWS], dict(CONFIG, hidden_cases={}), [], 3)
         self.assertTrue(doc["output"].startswith("1 of 3 points (steps 01). Each exercise"), doc["output"])
         self.assertEqual([t["visibility"] for t in doc["tests"]], ["visible", "visible"])
 

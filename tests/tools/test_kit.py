@@ -109,7 +109,7 @@ class KitContents(unittest.TestCase):
         self.assertIn("tests/grading_test.py", kit.NOT_IN_KIT)
         # The student's check ships in the kit (its end-to-end test, which uses the
         # solutions, does not).
-        for path in ("tools/check.py", "tools/pictures.py", "tools/png.py",
+        for path in ("tools/check.py", "tools/pictures.py", "tools/png.py", "tools/label.py",
                      "tests/hints/exercises.json", "tests/hints/mistakes.json"):
             self.assertNotIn(path, kit.NOT_IN_KIT)
         self.assertIn("tests/check_test.py", kit.NOT_IN_KIT)

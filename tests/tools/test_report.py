@@ -1,4 +1,4 @@
-"""Unit tests of tools/report.py: the Pareto front of error against time, and its plot."""
+"""Unit tests of tools/report.py and tools/plots.py: the Pareto front of error against time, its plot, the page."""
 import json
 import os
 import re
@@ -9,7 +9,8 @@ from unittest import mock
 from tests.tools import scratch  # noqa: F401  (tempfile's folders go into one removed at exit)
 
 from tools import png, report
-from tools.report import pareto_front, plot, table_html
+from tools.plots import pareto_front, plot
+from tools.report import table_html
 
 
 class ParetoFront(unittest.TestCase):
@@ -47,6 +48,45 @@ class Report(unittest.TestCase):
     def test_table_names_its_time_and_error(self):
         text = table_html(json.loads(json.dumps(self.TABLE)))
         self.assertIn("Time: <i>ms</i> (spread <i>lo</i> to <i>hi</i>); error: <i>err</i>", text)
+
+
+class StepGuide(unittest.TestCase):
+    """A step's section as a guide: the README's summary and marked points from the claims
+    check (out/claims.json), the links, the takeaways, the facts in words with units."""
+
+    def test_the_section_says_what_to_conclude(self):
+        step = {"program": "01_triangle", "machine": "m", "images": [], "plots": [],
+                "facts": {"render_ms": 12.5, "pixels_disagreeing": 3, "made_up_count": 1200,
+                          "refined_image_bit_identical": True},
+                "tables": [dict(Report.TABLE, rows=[["a", 1.0, 0.9, 1.1, 3.0]] * 7)]}
+        claims = {"counts": {"agree": 2, "fail": 0, "notMeasured": 0}, "guides": {"01_triangle": {
+            "summary": "It measured **this**. Conclude that.",
+            "bullets": [{"text": "A point, see [measuring.md](../../docs/measuring.md#x)", "status": "agree",
+                         "checks": [{"expression": "1 == 1", "status": "agree", "shown": "1 == 1"}]},
+                        {"text": "Another", "status": "unchecked", "checks": []}],
+            "takeaways": {"t": "Take `this` away."}}}}
+        with tempfile.TemporaryDirectory() as out:
+            for name, data in (("01_triangle.json", step), ("claims.json", claims)):
+                with open(os.path.join(out, name), "w") as f:
+                    json.dump(data, f)
+            with mock.patch("sys.argv", ["report", out]), mock.patch("sys.stderr"):
+                report.main()
+            with open(os.path.join(out, "index.html"), encoding="utf-8") as f:
+                text = f.read()
+        self.assertIn("<p class=summary>It measured <b>this</b>. Conclude that.</p>", text)
+        self.assertIn("class='point agree'", text)
+        self.assertIn("agrees with this run", text)
+        self.assertIn("class='point unchecked'", text)
+        root = os.path.relpath(report.ROOT, out)
+        self.assertIn(f"<a href='{os.path.join(root, 'docs', 'measuring.md')}#x'>measuring.md</a>", text)
+        self.assertIn(f"class=readme href='{os.path.join(root, 'steps', '01_triangle', 'README.md')}'", text)
+        self.assertIn("class=measuring href=", text)
+        self.assertIn("<details><summary>T", text)  # 7 rows: folded
+        self.assertIn("<span class=label>Takeaway</span> Take <code>this</code> away.", text)
+        self.assertIn("<dt>The image&#x27;s render time</dt><dd>12.5 ms</dd>", text)
+        self.assertIn("<dt>Made up count</dt><dd>1,200</dd>", text)
+        self.assertIn("<dd>yes</dd>", text)
+        self.assertNotIn("made_up_count", text)
 
 
 class ExerciseStatus(unittest.TestCase):

@@ -1,22 +1,19 @@
-"""Building a step's test program in the grading tree and running its exercise cases: the
-configure, the build (the step's hidden tests first, on their own), the reason a build
-fails, the list of cases, each case in its own sandboxed process and how it ended, and a
-step's rows for the report."""
+"""Building a step's worker in the grading tree and running its exercise cases: the
+configure, the build of the student's code behind the judge's call server (judge_worker_NN:
+no test in it), the reason a build fails, each case as a fresh checker and a fresh worker
+(tools/grading/judge), and a step's rows for the report."""
 import os
 import re
-import shutil
 import stat
 import sys
-import time
-import xml.etree.ElementTree as ET
 from dataclasses import dataclass
 
-from . import ROOT
 from .box import clean_env, sandboxed, write_private
 from .errors import GradeError
-from .exercises import MAX_RESULT_BYTES, case_results, step_dirs
+from .exercises import MAX_RESULT_BYTES
 from .grade_report import exercise_row, printable, say
-from .grading_tree import HIDDEN_DIR, hidden_copies, read, set_hidden_mode
+from . import judge
+from .grading_tree import read
 
 
 # The grading build's optimization: -O1, not Release's -O3. A student's grade is mostly the
@@ -36,10 +33,7 @@ GRADING_CACHE = {"CMAKE_BUILD_TYPE": "Release", "CMAKE_CXX_FLAGS_RELEASE": GRADI
 def configure(work, iso):
     """Configures the grading tree once (sandboxed like the builds: it reads the reference's
     CMake files, but writes only WORK/build); exits with the reason when that fails. Then
-    regenerates the build files if the CMake files changed (hidden tests added, say), so no
-    build needs to: CMake takes a source it cannot read for a missing one, and the hidden
-    tests are readable only now (CMake reads no file of the student's) and while they
-    compile."""
+    regenerates the build files if the CMake files changed, so no build needs to."""
     build = os.path.join(work, "build")
     cache_file = os.path.join(build, "CMakeCache.txt")
     cache = read(cache_file).splitlines() if os.path.exists(cache_file) else []
@@ -48,18 +42,14 @@ def configure(work, iso):
     fresh = os.path.exists(os.path.join(build, "build.ninja")) and all(
         configured.get(k) == v for k, v in GRADING_CACHE.items())
     os.makedirs(build, exist_ok=True)
-    set_hidden_mode(work, 0o644)
-    try:
-        if not fresh:
-            say("configuring the grading tree (once; later grades reuse it)", iso.log)
-            r = sandboxed(["cmake", "-S", os.path.join(work, "src"), "-B", build, "-G", "Ninja"] +
-                          [f"-D{k}={v}" for k, v in GRADING_CACHE.items()], iso.build, iso,
-                          writable=[build], env=clean_env(build), readable=[os.path.join(work, "src")])
-        else:
-            r = sandboxed(["cmake", "--build", build, "--target", "build.ninja"], iso.build, iso,
-                          writable=[build], env=clean_env(build), readable=[os.path.join(work, "src")])
-    finally:
-        set_hidden_mode(work, 0)
+    if not fresh:
+        say("configuring the grading tree (once; later grades reuse it)", iso.log)
+        r = sandboxed(["cmake", "-S", os.path.join(work, "src"), "-B", build, "-G", "Ninja"] +
+                      [f"-D{k}={v}" for k, v in GRADING_CACHE.items()], iso.build, iso,
+                      writable=[build], env=clean_env(build), readable=[os.path.join(work, "src")])
+    else:
+        r = sandboxed(["cmake", "--build", build, "--target", "build.ninja"], iso.build, iso,
+                      writable=[build], env=clean_env(build), readable=[os.path.join(work, "src")])
     if not r.ok:
         (iso.log or sys.stderr).write((r.stdout + r.stderr).decode(errors="replace"))
         raise GradeError(f"grade: configuring the grading tree failed ({r.reason}; see above)")
@@ -77,36 +67,13 @@ def cmake_build(work, targets, iso):
 
 
 def build_step(work, number, iso):
-    """'' when test_stepNN builds, else the reason it does not ('does not compile: ...').
-
-    The step's hidden tests compile first, on their own: only then may they be read, and what
-    the compiler says of them (the student's headers can make it quote them) goes to the
-    instructor's log, never into the reason. The rest of the build cannot read them."""
+    """'' when the step's worker builds (judge_worker_NN: the student's step sources, those of
+    the steps it links and the judge's call server; no test, hidden or not), else the reason
+    it does not ('does not compile: ...')."""
     src = os.path.join(work, "src")
-    name = next(os.path.basename(d) for d in step_dirs(ROOT) if os.path.basename(d).startswith(number))
-    hidden_failed = None
-    copies = hidden_copies(work, number)
-    if copies:
-        set_hidden_mode(work, 0o644, number)
-        try:
-            r = cmake_build(work, [f"tests/CMakeFiles/test_step{number}.dir/{HIDDEN_DIR[6:]}/"
-                                   f"{os.path.basename(c)}.o" for c in copies], iso)
-        finally:
-            set_hidden_mode(work, 0, number)
-        if not r.ok:
-            write_private(os.path.join(work, f"build-step{number}-hidden.log"),
-                          (r.stdout + r.stderr).decode(errors="replace") + f"\n[grade] build result: {r.reason}\n")
-            hidden_failed = r
-    # Without the hidden tests' objects test_stepNN cannot link: then the student's own
-    # sources and the public tests, whose errors the student may see.
-    targets = ([f"step{name}", f"tests/CMakeFiles/test_step{number}.dir/step{name}.cpp.o"]
-               if hidden_failed else [f"test_step{number}"])
-    r = cmake_build(work, targets, iso)
-    if r.ok and not hidden_failed:
-        return ""
+    r = cmake_build(work, [f"judge_worker_{number}"], iso)
     if r.ok:
-        return (f"does not compile: step {number}'s hidden tests do not compile with these sources "
-                f"({hidden_failed.reason}; the compiler's messages are for the instructor)")
+        return ""
     output = (r.stdout + r.stderr).decode(errors="replace")
     write_private(os.path.join(work, f"build-step{number}.log"), output + f"\n[grade] build result: {r.reason}\n")
     return build_reason(r, output, src)
@@ -140,43 +107,13 @@ def first_error(output, src):
     return "the build failed"
 
 
-def test_readable(binary):
-    """What a test program reads: its build tree (WORK/build) and the data (WORK/src/data)."""
-    build = os.path.dirname(os.path.dirname(binary))
-    return [build, os.path.join(os.path.dirname(build), "src", "data")]
-
-
-def list_cases(binary, iso, folder):
-    """[(suite, test case)] of a test program, or raises RuntimeError saying why not."""
-    os.makedirs(folder, exist_ok=True)
-    if iso.drop:
-        os.chown(folder, iso.user.uid, iso.user.gid)
-    limits = iso.test
-    r = sandboxed([binary, "--list-test-cases", "--reporters=xml"], limits, iso, scratch=folder,
-                  env=clean_env(folder), keep=int(limits.output_mb * (1 << 20)),
-                  readable=test_readable(binary))
-    return listed_cases(r)
-
-
-def listed_cases(r):
-    """[(suite, test case)] from the sandbox result of --list-test-cases --reporters=xml, or
-    raises RuntimeError(status, reason) when its output is no such list."""
-    try:
-        root = ET.fromstring(r.stdout.decode(errors="replace"))
-    except ET.ParseError as e:
-        # Before any test runs: the student's code in a global object's constructor, say.
-        status = r.status if r.status not in ("ok", "failed") else "failed"
-        reason = r.reason if status != "failed" else f"failed: {r.reason}"
-        raise RuntimeError(status, f"{reason} (the test program does not list its tests)") from e
-    return [(c.get("testsuite", ""), c.get("name", "")) for c in root.iter("TestCase")]
-
-
 @dataclass
 class CaseOutcome:
     name: str
     status: str  # passed | failed | time limit | memory limit | output limit | crashed
     reason: str  # "" when passed, else e.g. "crashed: SIGSEGV" or "failed: <assertion>"
     seconds: float
+    hidden: bool = False  # one of the instructor's hidden tests
 
     @property
     def passed(self):
@@ -186,28 +123,6 @@ class CaseOutcome:
 def doctest_filter(name):
     """doctest splits a filter at commas: a comma inside a name is escaped."""
     return name.replace(",", "\\,")
-
-
-def run_case(binary, suite, name, iso, folder):
-    """One test case in its own sandboxed process, in a fresh writable folder (isolated: a
-    tmpfs of the test's disk limit, so no test fills the grading disk), with the test
-    limits. doctest writes its results to a file there (the one file that reaches the
-    host), so what the student's code prints is only counted against the output limit,
-    never read as a result."""
-    os.makedirs(folder)
-    if iso.drop:
-        os.chown(folder, iso.user.uid, iso.user.gid)
-    result = os.path.join(folder, "result.xml")
-    cmd = [binary, "--test-suite=" + doctest_filter(suite), "--test-case=" + doctest_filter(name),
-           "--reporters=xml", "--no-version", f"--out={result}"]
-    try:
-        r = sandboxed(cmd, iso.test, iso, scratch=folder, outputs=[result], env=clean_env(folder),
-                      keep=1 << 16, readable=test_readable(binary))
-        data = read_result(result)
-        found = [c for c in case_results(data) if c.name == name] if data else []
-    finally:
-        shutil.rmtree(folder, ignore_errors=True)
-    return case_outcome(name, r, found)
 
 
 def read_result(path):
@@ -224,45 +139,50 @@ def read_result(path):
         return f.read(MAX_RESULT_BYTES + 1)
 
 
-def case_outcome(name, r, found):
-    """How one test case ended, from its sandbox result r and the results doctest wrote for
-    it (found: the CaseResults named `name`; [] when it wrote none)."""
-    if r.status in ("time limit", "memory limit", "output limit", "crashed"):
-        return CaseOutcome(name, r.status, r.reason, r.seconds)
-    if found and found[0].passed and r.ok:
-        return CaseOutcome(name, "passed", "", r.seconds)
-    if found and not found[0].passed:
-        message = found[0].message
-        if "bad_alloc" in message:  # doctest caught the refused allocation
-            return CaseOutcome(name, "memory limit", "memory limit", r.seconds)
-        return CaseOutcome(name, "failed", f"failed: {message or 'the test case failed'}", r.seconds)
-    if found:  # passed, but the process then failed (at exit: the student's code still ran)
-        return CaseOutcome(name, "failed", f"failed: the test passed, then the program ended with "
-                           f"{r.reason}", r.seconds)
-    last = (r.stderr.decode(errors="replace").strip().splitlines() or [""])[-1][:200]
-    why = "no test result (it ended before doctest wrote one)" if r.ok else f"no test result, {r.reason[8:]}"
-    return CaseOutcome(name, "failed", f"failed: {why}" + (f": {last}" if last else ""), r.seconds)
-
-
-def grade_step(work, number, items, iso, scratch, notes, log, t0):
-    """The rows of one step's exercises: its build, then each exercise case on its own."""
+def build_and_run_visible(work, number, items, iso, runner, checker, log):
+    """The first half of a step: its worker's build, then its visible cases (a fresh checker
+    and worker each, judge.run_case). Returns (build error, {exercise: [CaseOutcome]})."""
     error = build_step(work, number, iso)
     outcomes = {e.id: [] for e in items}
     if not error:
-        binary = os.path.join(work, "build", "tests", f"test_step{number}")
-        try:
-            cases = [(s, n) for s, n in list_cases(binary, iso, os.path.join(scratch, "list"))
-                     if s.startswith("exercise ")]
-        except RuntimeError as e:
-            error, cases = tuple(e.args), []
-        say(f"step {number}: running {len(cases)} test cases", log)
-        for i, (suite, name) in enumerate(cases):
-            ex = suite.split(" ", 1)[1]
-            if ex not in outcomes:
-                notes.append(f"suite '{suite}' has no exercise marker: not counted")
-                outcomes[ex] = []
-            o = run_case(binary, suite, name, iso, os.path.join(scratch, f"{number}-{i}"))
-            if not o.passed:
-                say(printable(f"step {number}: {name}: {o.reason}"), log)
-            outcomes[ex].append(o)
-    return [exercise_row(e, number, error, outcomes[e.id], time.monotonic() - t0) for e in items]
+        error = judge.probe(runner, os.path.join(work, "build", f"judge_worker_{number}"), f"{number}-probe")
+        if error:
+            say(printable(f"step {number}: {error[1]}"), log)
+    if not error:
+        run_cases(work, number, [c for c in checker.cases if not c.hidden], runner, checker, outcomes, log)
+    return error, outcomes
+
+
+def run_hidden(work, number, runner, checker, error, outcomes, log):
+    """The second half: the step's hidden cases, once every step's visible cases have run,
+    so that no worker of a visible case ever runs after a worker that saw a hidden input."""
+    if not error:
+        run_cases(work, number, [c for c in checker.cases if c.hidden], runner, checker, outcomes, log)
+
+
+def run_cases(work, number, cases, runner, checker, outcomes, log):
+    if not cases:
+        return
+    worker = os.path.join(work, "build", f"judge_worker_{number}")
+    hidden = cases[0].hidden
+    say(f"step {number}: running {len(cases)} {'hidden' if hidden else 'visible'} test cases", log)
+    for case in cases:
+        outcomes.setdefault(case.exercise, [])
+        i = checker.cases.index(case)
+        status, reason, seconds = judge.run_case(runner, checker, case, worker, f"{number}-{i}")
+        o = CaseOutcome(case.name, status, reason, seconds, case.hidden)
+        if not o.passed:
+            say(printable(f"step {number}: {'(hidden) ' if hidden else ''}{case.name}: {o.reason}"), log)
+        outcomes[case.exercise].append(o)
+
+
+def step_rows(number, items, checker, error, outcomes, notes, seconds):
+    """The rows of one step's exercises, from its build and its cases' outcomes."""
+    for ex in outcomes:
+        if ex not in {e.id for e in items}:
+            notes.append(f"suite 'exercise {ex}' has no exercise marker: not counted")
+    hidden = {}
+    for case in checker.cases:
+        hidden[case.exercise] = hidden.get(case.exercise, 0) + case.hidden
+    return [exercise_row(e, number, error, outcomes.get(e.id, []), seconds, hidden.get(e.id, 0))
+            for e in items]

@@ -10,13 +10,18 @@ What the student owns: the C++ sources and headers in the step folders (steps/NN
 data/. The grading tree is assembled in WORK/src (default build/grade/src): the reference's
 files, the step sources of the starter kit (so a file the student deleted is a stub, never
 the reference solution), then the student's step sources over them. An instructor's hidden
-tests (--hidden DIR) are doctest files named stepNN*.cpp; each is compiled into that step's
-test program (test_stepNN) and its TEST_SUITE("exercise N.M") cases count for exercise N.M.
+tests (--hidden DIR) are doctest files named stepNN*.cpp; their cases of a suite "exercise
+N.M", in whatever doctest form, count for exercise N.M.
 
-Each step's test program is built on its own, so a step that does not compile scores zero
-for its exercises (with the compiler's first error) and the other steps are still graded. Each
-test case of an "exercise N.M" suite runs as its own process; an exercise earns its points
-(from the reference's markers) when it has test cases and all of them pass.
+The judge (tools/grading/judge) runs every test case as a checker (the reference's tests
+and every expected value, built once for every student in WORK/judge: no student code, no
+student file compiled) and a worker (the student's functions behind a call server, no test
+at all), joined by pipes: the worker answers calls, the checker decides. Hidden tests are
+only ever in the judge's folder, in a checker of their own that runs the hidden cases only,
+after every visible case. Each step's worker is built on its own, so a step that does not
+compile scores zero for its exercises (with the compiler's first error) and the other steps
+are still graded. An exercise earns its points (from the reference's markers) when it has
+test cases and all of them pass.
 
 The student's code is untrusted: the configure, every build (the compilers read the
 student's sources) and every test case run in sandbox.py's sandbox (bubblewrap: the
@@ -24,8 +29,9 @@ system read-only, one writable folder: WORK/build for a build, a fresh folder pe
 case; a private /tmp, no network, no capabilities) with limits on wall-clock and CPU time,
 memory (address space) and output (--timeout, --memory, --output per test case;
 --build-timeout, --build-memory per step's build). Where bubblewrap cannot create
-namespaces the grader says so and refuses, unless --no-isolation. The tests write their
-results to a file, so what the student's code prints only counts against the output limit.
+namespaces the grader says so and refuses, unless --no-isolation. The checker writes its
+results to a file of its own, so what the student's code prints only counts against the
+output limit.
 A failing exercise says why: time limit, memory limit, output limit, crashed: SIGNAME,
 failed: <first failing assertion>, does not compile: <first error or the limit it hit>.
 The points table goes to the terminal, a JUnit XML file to --junit (default WORK/grade.xml;
@@ -52,12 +58,13 @@ import traceback
 from dataclasses import dataclass
 
 from . import ROOT, sandbox
+from . import judge
 from .box import Isolation, check_user_access, disk_trouble, refuse_without_isolation
-from .build_and_run import configure, grade_step
+from .build_and_run import GRADING_CACHE, build_and_run_visible, configure, run_hidden, step_rows
 from .errors import NOT_GRADED_EXIT, GradeError, NotGraded, OutOfTime
 from .exercises import BEGIN, exercises, step_sources
-from .grade_report import exercise_row, print_table, printable, results_by_exercise, say, write_json, write_junit
-from .grading_tree import assemble, hidden_copies, share_tree
+from .grade_report import print_table, printable, results_by_exercise, say, write_json, write_junit
+from .grading_tree import assemble, hidden_sources, share_tree
 from .strict_numbers import MAX_JOBS, MAX_MB, MAX_SECONDS, decimal, integer, step_list
 from .users import grading_user
 
@@ -70,7 +77,7 @@ class GradeOptions:
     hidden: str = None  # folder of hidden doctest files stepNN*.cpp
     junit: str = None  # the JUnit XML file (None: WORK/grade.xml)
     json: str = None  # the per-exercise JSON file (None: none)
-    timeout: float = 60.0  # seconds of one test case, wall clock
+    timeout: float = 60.0  # CPU seconds of one test case's worker (judge.case_limits: wall 3x)
     memory: int = 2048  # MB of address space of a test process
     output: float = 16.0  # MB printed, and of any file a test writes
     build_timeout: float = 900.0  # seconds of one step's build
@@ -81,6 +88,7 @@ class GradeOptions:
     no_isolation: bool = False  # without bubblewrap (the limits still hold)
     user: str = None  # without bubblewrap, as root: the unprivileged user student code runs as
     private: tuple = ()  # more paths that user must not read (the class grader's results)
+    judge: str = None  # the checkers' folder (None: WORK/judge); graders of one class share one
 
 
 @dataclass
@@ -129,7 +137,8 @@ def scrub_solution_outputs(work, log=None):
             path = os.path.join(d, n)
             rel = os.path.relpath(path, build)
             whole_step = r.returncode != 0 and rel.startswith(("steps/", "tests/")) and n.endswith(".o")
-            program = rel.startswith("tests/test_step") and os.sep not in rel[len("tests/"):]
+            program = ((rel.startswith("tests/test_step") and os.sep not in rel[len("tests/"):])
+                       or (n.startswith("judge_worker_") and os.sep not in rel))
             if rel in doomed or whole_step or n.endswith(".a") or program:
                 os.remove(path)
 
@@ -166,7 +175,8 @@ def grade(student, opts, out=None, log=None, deadline=None, partial=False):
     elif opts.no_isolation and os.geteuid() == 0:
         say("WARNING: as root without --user, student code runs as root", log)
     hidden = opts.hidden and os.path.abspath(opts.hidden)
-    unreadable = (ROOT, student_path, hidden, os.path.expanduser("~"), "/home", "/root")
+    judge_folder = os.path.abspath(opts.judge or os.path.join(work, "judge"))
+    unreadable = (ROOT, student_path, hidden, judge_folder, os.path.expanduser("~"), "/home", "/root")
     # A build's files: the largest the grading build makes is a few tens of MB; one file of
     # a student's build (a huge initialised array, say) stops there.
     iso = Isolation(not opts.no_isolation,
@@ -175,60 +185,98 @@ def grade(student, opts, out=None, log=None, deadline=None, partial=False):
                     hidden=tuple(dict.fromkeys(p for p in unreadable if p)), deadline=deadline, log=log,
                     user=user, disk=work)
     try:
-        return _grade(student_path, opts, out, log, partial, work, all_ex, steps, hidden, iso, started)
+        return _grade(student_path, opts, out, log, partial, work, all_ex, steps, hidden, iso, started,
+                      judge_folder)
     except OSError as e:
         if e.errno in (errno.ENOSPC, errno.EDQUOT):
             raise NotGraded(f"the grading disk is full ({e.strerror}: {printable(str(e.filename))})") from e
         raise
 
 
-def _grade(student_path, opts, out, log, partial, work, all_ex, steps, hidden, iso, started):
+def _grade(student_path, opts, out, log, partial, work, all_ex, steps, hidden, iso, started, judge_folder):
     os.makedirs(os.path.join(work, "build"), exist_ok=True)
     trouble = disk_trouble(work)
     if trouble:
         raise NotGraded(trouble)
-    notes = assemble(student_path, hidden, work, steps)
+    # The checkers: the reference's tests and the hidden ones, built once for every tree
+    # graded here (or in a folder graders share), outside any sandbox: no student file in them.
+    numbers = sorted({f"{e.step:02d}" for e in all_ex})
+    hidden_by_step = hidden_sources(hidden, set(numbers), steps)
+    try:
+        checkers = judge.prepare(ROOT, judge_folder, hidden_by_step, steps, GRADING_CACHE, opts.jobs,
+                                 timeout=max(opts.build_timeout, 3600.0), say=lambda t: say(t, log))
+    except judge.JudgeError as e:
+        raise GradeError(f"grade: {e}") from None
+    workers, cmake = judge.worker_files(ROOT, steps)
+    notes = assemble(student_path, work, workers, cmake)
+    notes += [f"hidden tests for step {n}: {', '.join(name for name, _ in files)}"
+              for n, files in sorted(hidden_by_step.items())]
     if os.geteuid() == 0:  # student code runs as another user (iso.user, or the sandbox's own)
         os.chmod(os.path.join(work, "build"), 0o755)
         share_tree(os.path.join(work, "src"))
     if iso.drop:
         os.chmod(work, 0o755)
         solutions = [os.path.join(ROOT, rel) for rel in solution_files()[:1]]
-        check_user_access(iso, work, solutions + [hidden] + hidden_copies(work) + list(opts.private))
+        check_user_access(iso, work, solutions + [hidden, judge_folder] + list(opts.private))
         notes.append(f"student code ran without isolation, as user {iso.user.name}")
     elif not iso.isolate:
         notes.append("student code ran without isolation (--no-isolation)")
-    rows = []
-
-    def out_of_time(k, what):
-        # With `partial`, the exercises not graded in time fail with that reason.
-        if not partial:
-            raise OutOfTime()
-        why = ("time limit", "not graded: the grading ran past its overall time limit")
-        for later in steps[k:]:
-            rows.extend(exercise_row(e, later, why, [], 0.0) for e in all_ex if f"{e.step:02d}" == later)
-        say(f"out of time {what}: its exercises and the later ones are not graded", log)
-
+    graded = {}  # step: [build error, {exercise: [CaseOutcome]}, seconds]
+    done = set()  # the steps whose every case ran
+    late = None  # when out of time (with `partial`): where
     try:
         configure(work, iso)
     except OutOfTime:
-        out_of_time(0, "while configuring")
-        steps = []
-    # The test cases' folders: in WORK (the clone's build/ by default), not the shared /tmp,
-    # and removed when grading ends, however it ends.
-    with tempfile.TemporaryDirectory(prefix="scratch-", dir=work, ignore_cleanup_errors=True) as scratch:
+        if not partial:
+            raise
+        late, steps_to_run = "while configuring", []
+    else:
+        steps_to_run = steps
+    # The cases' folders: the workers' in WORK (the clone's build/ by default), not the shared
+    # /tmp; the checkers' in the judge folder, out of every sandbox's sight; both removed when
+    # grading ends, however it ends.
+    with tempfile.TemporaryDirectory(prefix="scratch-", dir=work, ignore_cleanup_errors=True) as scratch, \
+            tempfile.TemporaryDirectory(prefix="cases-", dir=judge_folder, ignore_cleanup_errors=True) as private:
         if iso.drop:
             os.chmod(scratch, 0o711)  # the user reaches its case folders, lists nothing
-        for k, number in enumerate(steps):
-            items = [e for e in all_ex if f"{e.step:02d}" == number]
-            say(f"step {number}: building test_step{number}", log)
-            t0 = time.monotonic()
-            try:
-                step_rows = grade_step(work, number, items, iso, scratch, notes, log, t0)
-            except OutOfTime:
-                out_of_time(k, f"at step {number}")
-                break
-            rows += step_rows
+        runner = judge.Runner(iso, scratch, private,
+                              worker_readable=[os.path.join(work, "build"), os.path.join(work, "src", "data")],
+                              judge_folder=judge_folder)
+        try:
+            # Every step's visible cases first, then the hidden ones: no worker of a visible
+            # case runs after one that saw a hidden case's input.
+            for number in steps_to_run:
+                items = [e for e in all_ex if f"{e.step:02d}" == number]
+                say(f"step {number}: building judge_worker_{number} (the student's code)", log)
+                t0 = time.monotonic()
+                error, outcomes = build_and_run_visible(work, number, items, iso, runner, checkers[number], log)
+                graded[number] = [error, outcomes, time.monotonic() - t0]
+                if not any(c.hidden for c in checkers[number].cases):
+                    done.add(number)
+            for number in steps_to_run:
+                if number in done:
+                    continue
+                error, outcomes, _ = graded[number]
+                t0 = time.monotonic()
+                run_hidden(work, number, runner, checkers[number], error, outcomes, log)
+                graded[number][2] += time.monotonic() - t0
+                done.add(number)
+        except OutOfTime:
+            if not partial:
+                raise
+            late = "while running the cases"
+    if late:
+        say(f"out of time {late}: the exercises of step{'s' if len(steps) - len(done) > 1 else ''} "
+            f"{', '.join(n for n in steps if n not in done)} are not graded", log)
+    rows = []
+    why = ("time limit", "not graded: the grading ran past its overall time limit")
+    for number in steps:
+        items = [e for e in all_ex if f"{e.step:02d}" == number]
+        if number in done:
+            error, outcomes, seconds = graded[number]
+            rows += step_rows(number, items, checkers[number], error, outcomes, notes, seconds)
+        else:
+            rows += step_rows(number, items, checkers[number], why, {}, notes, 0.0)
     notes = [printable(n) for n in notes]
     if student_path == ROOT:
         scrub_solution_outputs(work, log)
@@ -304,7 +352,8 @@ def main(argv):
     p.add_argument("--junit", help="JUnit XML file to write (default WORK/grade.xml)")
     p.add_argument("--json", help="also write the per-exercise results as JSON to this file")
     p.add_argument("--timeout", type=decimal(0, MAX_SECONDS), default=defaults.timeout,
-                   help="time limit of one test case in seconds, wall clock (default %(default)g)")
+                   help="time limit of one test case in seconds: CPU time of the student's code, "
+                        "three times that on the wall clock (default %(default)g)")
     p.add_argument("--memory", type=integer(1, MAX_MB), default=defaults.memory,
                    help="memory limit of a test process in MB, address space (default %(default)d)")
     p.add_argument("--output", type=decimal(0, MAX_MB), default=defaults.output,

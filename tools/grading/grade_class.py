@@ -49,7 +49,7 @@ CACHE_VERSION = 1
 GRADER_FILES = ("tools/grading/grade.py", "tools/grading/grade_report.py", "tools/grading/grading_tree.py",
                 "tools/grading/box.py", "tools/grading/build_and_run.py", "tools/grading/errors.py",
                 "tools/grading/exercises.py", "tools/grading/kit.py", "tools/grading/sandbox",
-                "tools/grading/submissions.py")
+                "tools/grading/submissions.py", "tools/grading/judge/")
 
 
 def say(text):
@@ -58,13 +58,14 @@ def say(text):
 
 
 def run_grader(tree, work, report_dir, steps=None, hidden=None, timeout=60.0, jobs=1,
-               no_sandbox=False, limit=None, user=None, partial=False):
+               no_sandbox=False, limit=None, user=None, partial=False, judge=None):
     """Grades one tree in-process into report_dir (points.txt, grade.log, grade.xml,
     grade.json) in the grading folder `work`; returns grade.Report (code None: it ran out of
     `limit` seconds; with `partial` the exercises not graded by then fail instead). `user`:
-    without the sandbox, as root, the unprivileged user student code runs as."""
+    without the sandbox, as root, the unprivileged user student code runs as. `judge`: the
+    checkers' folder (default WORK/judge); the class's grading folders share one."""
     opts = GradeOptions(work=work, timeout=timeout, jobs=jobs, steps=steps, hidden=hidden,
-                        no_isolation=no_sandbox, user=user)
+                        no_isolation=no_sandbox, user=user, judge=judge)
     return grade_into(report_dir, tree, opts, limit, partial)
 
 
@@ -111,6 +112,10 @@ class Workers:
     def dir(self, i):
         return os.path.join(self.root, f"w{i}")
 
+    def judge(self):
+        """The checkers' folder every worker shares: built once for the class."""
+        return os.path.join(self.root, "judge")
+
     def take(self):
         with self.cv:
             while not self.free:
@@ -145,7 +150,7 @@ def prime(workers, count, opts, key):
     def one(i):
         report = os.path.join(workers.dir(i), "reference")
         r = run_grader(ROOT, workers.dir(i), report, opts.steps, opts.hidden, opts.timeout,
-                       opts.compile_jobs, opts.no_sandbox)
+                       opts.compile_jobs, opts.no_sandbox, judge=workers.judge())
         rows = r.results if r.code == 0 else None
         results[i] = (r.code, rows, r.seconds)
         if r.code == 0 and rows and all(x["passed"] for x in rows):
@@ -204,7 +209,7 @@ def _grade_one(sub, workers, opts, result):
             result.update(status="error", build=f"not graded: staging failed ({e}){RETRY}", rows=[], total=0)
             return result
         r = run_grader(tree, workers.dir(i), report, opts.steps, opts.hidden, opts.timeout,
-                       opts.compile_jobs, opts.no_sandbox, opts.student_timeout)
+                       opts.compile_jobs, opts.no_sandbox, opts.student_timeout, judge=workers.judge())
     finally:
         workers.give(i)
     result["seconds"] = round(r.seconds, 2)

@@ -37,10 +37,12 @@ def say(text, log=None):
     print(f"[grade] {text}", file=log or sys.stderr, flush=True)
 
 
-def exercise_row(e, number, build_error, outcomes, seconds):
+def exercise_row(e, number, build_error, outcomes, seconds, hidden=0):
     """The report's row of one exercise: passed when it has test cases and all pass; else the
     reason of its first failing case, of its step's build ('does not compile: ...'), or
-    (status, reason) of a test program that does not start."""
+    (status, reason) of a test program that does not start. `hidden`: how many of the
+    exercise's cases are the instructor's hidden tests (whether they ran or not);
+    public_details and public_passed say how its other cases went, nothing of the hidden."""
     failed = [o for o in outcomes if not o.passed]
     if isinstance(build_error, tuple):  # the test program does not start
         (status, reason), case = build_error, ""
@@ -55,11 +57,16 @@ def exercise_row(e, number, build_error, outcomes, seconds):
     reason = printable(reason)
     reason = reason if len(reason) <= 500 else reason[:497] + "..."
     message = reason + (f' (test case "{case}")' if case else "")
-    details = [printable(f"{'passed' if o.passed else 'FAILED'}: {o.name}" + ("" if o.passed else f": {o.reason}"))
-               for o in outcomes] or [message]
+    def line(o):
+        return printable(f"{'passed' if o.passed else 'FAILED'}: {o.name}" + ("" if o.passed else f": {o.reason}"))
+
+    details = [line(o) for o in outcomes] or [message]
+    public = [o for o in outcomes if not getattr(o, "hidden", False)]
     return {"id": e.id, "title": e.title, "points": e.points, "step": number,
             "passed": status == "passed", "status": status, "reason": reason, "case": case,
-            "message": message, "details": details,
+            "message": message, "details": details, "hidden": hidden,
+            "public_details": [line(o) for o in public] or ([message] if build_error else []),
+            "public_passed": bool(public) and all(o.passed for o in public),
             "seconds": sum(o.seconds for o in outcomes) if outcomes else seconds}
 
 
@@ -114,12 +121,14 @@ def write_json(path, rows, notes, seconds):
     """The per-exercise results as JSON, for batch grading and other tools: one object per
     exercise with its points earned (0 unless passed), max, status (passed, failed, time
     limit, memory limit, output limit, crashed, does not compile, no tests), reason (empty
-    when passed), the first failing test case and seconds."""
+    when passed), the first failing test case, details (a line per test case: how it went),
+    hidden (how many of its cases are the instructor's hidden tests) and seconds."""
     doc = {"points": sum(r["points"] for r in rows if r["passed"]),
            "max": sum(r["points"] for r in rows), "seconds": round(seconds, 2),
            "exercises": [{"exercise": r["id"], "title": r["title"], "step": r["step"],
                           "points": r["points"] if r["passed"] else 0, "max": r["points"],
                           "status": r["status"], "reason": r["reason"], "case": r["case"],
+                          "details": list(r["details"]), "hidden": r.get("hidden", 0),
                           "seconds": round(r["seconds"], 2)}
                          for r in rows],
            "notes": list(notes)}
@@ -132,7 +141,8 @@ def write_json(path, rows, notes, seconds):
 def results_by_exercise(rows):
     """The rows as the class grader and Gradescope keep them, one dict per exercise:
     exercise, title, step, max, passed, points (earned), status, reason (with the first
-    failing test case in front), details (a line per test case), seconds."""
+    failing test case in front), details (a line per test case), hidden (how many cases are
+    hidden tests), public_details and public_passed (the other cases only), seconds."""
     results = []
     for r in rows:
         reason = r["reason"]
@@ -143,5 +153,7 @@ def results_by_exercise(rows):
                         "passed": r["passed"], "points": r["points"] if r["passed"] else 0,
                         "status": r["status"], "reason": reason,
                         "details": [line for line in details.splitlines() if line.strip()],
+                        "hidden": r.get("hidden", 0), "public_details": r.get("public_details", []),
+                        "public_passed": r.get("public_passed", False),
                         "seconds": round(r["seconds"], 2)})
     return results

@@ -246,11 +246,16 @@ def results_json(rows, config, notes, seconds):
     """Gradescope's results.json for the graded rows. Every text is plain text (it holds
     what the student's code printed and the names of their files). With hidden tests the
     top-level output, which students always see, counts only the exercises without any."""
-    hidden_cases = config.get("hidden_cases", {})
     visibility = config.get("hidden_visibility", "after_published")
     tests = []
+    if config.get("hidden_cases") or any(r.get("hidden", 0) for r in rows):
+        # Which hidden test files and suites there are is not for them either.
+        notes = [n for n in notes if not n.startswith(("hidden tests", "suite '"))]
+
+    def has_hidden(r):  # the grader's own list of the checker's cases: whatever doctest form
+        return r.get("hidden", 0) > 0
+
     for r in rows:
-        hidden_names = set(hidden_cases.get(r["exercise"], []))
         lines = [f"{r['points']} of {r['max']} points: {'passed' if r['passed'] else r['status']}"]
         if not r["passed"] and r["reason"]:
             lines.append(f"first failure: {r['reason']}")
@@ -258,17 +263,17 @@ def results_json(rows, config, notes, seconds):
         tests.append({"name": f"exercise {r['exercise']}: {r['title']}", "number": r["exercise"],
                       "score": r["points"], "max_score": r["max"],
                       "status": "passed" if r["passed"] else "failed", "output": "\n".join(lines),
-                      "visibility": visibility if hidden_names else "visible"})
-        if hidden_names:
-            public = [d for d in r["details"] if not any(d.split(": ", 1)[-1].startswith(h) for h in hidden_names)]
-            ok = all(d.startswith("passed") for d in public) and bool(public)
+                      "visibility": visibility if has_hidden(r) else "visible"})
+        if has_hidden(r):
+            public = r.get("public_details", [])
             tests.append({"name": f"exercise {r['exercise']}: public tests", "number": f"{r['exercise']}.0",
-                          "score": 0, "max_score": 0, "status": "passed" if ok else "failed",
+                          "score": 0, "max_score": 0,
+                          "status": "passed" if r.get("public_passed") else "failed",
                           "output": "\n".join(public) or "no public test cases", "visibility": "visible"})
-    shown = [r for r in rows if not hidden_cases.get(r["exercise"])]
+    shown = [r for r in rows if not has_hidden(r)]
     steps = ", ".join(config["steps"])
     if len(shown) < len(rows):
-        held = [r["exercise"] for r in rows if hidden_cases.get(r["exercise"])]
+        held = [r["exercise"] for r in rows if has_hidden(r)]
         head = (f"{sum(r['points'] for r in shown)} of {sum(r['max'] for r in shown)} points from the "
                 f"exercises without hidden tests (steps {steps}). Exercises {', '.join(held)} also have "
                 f"hidden tests: their points show {WHEN.get(visibility, 'later')}.")

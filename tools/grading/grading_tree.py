@@ -1,6 +1,6 @@
 """The grading tree in WORK/src: the reference's files, the starter kit's stubs of the step
-sources, the student's step sources over them, and the instructor's hidden tests under
-neutral names, kept unreadable except while they compile."""
+sources, the student's step sources over them and the judge's workers (a call server per
+step). No hidden test is ever in it: those live in the judge's folder (tools/grading/judge)."""
 import os
 import re
 
@@ -73,30 +73,21 @@ def sync_tree(dest, files):
             os.rmdir(d)
 
 
-HIDDEN_DIR = "tests/hidden"  # where the grading tree keeps the hidden tests
+def hidden_sources(hidden, step_numbers, steps):
+    """{step: [(file name, bytes)]} of the instructor's hidden tests of the graded steps."""
+    by_step = {}
+    for number, names in hidden_tests(hidden, step_numbers).items():
+        if number in steps:
+            for n in names:
+                with open(os.path.join(hidden, n), "rb") as f:
+                    by_step.setdefault(number, []).append((n, f.read()))
+    return by_step
 
 
-def hidden_copies(work, number=None):
-    """The grading tree's copies of the hidden tests (of step `number`, or all)."""
-    folder = os.path.join(work, "src", HIDDEN_DIR)
-    if not os.path.isdir(folder):
-        return []
-    return [os.path.join(folder, n) for n in sorted(os.listdir(folder))
-            if number is None or n.startswith(f"step{number}_")]
-
-
-def set_hidden_mode(work, mode, number=None):
-    """chmod the hidden tests' copies: 0 while student code runs or a student's own source
-    compiles (not even their owner may read them then: bubblewrap's nobody is the grader
-    outside), readable only while they compile themselves."""
-    for path in hidden_copies(work, number):
-        os.chmod(path, mode)
-
-
-def assemble(student, hidden, work, steps):
-    """Writes the grading tree into work/src; returns the notes for the report. The hidden
-    tests' copies get neutral names (tests/hidden/stepNN_K.cpp: nothing in the tree says
-    what the instructor called them) and are left unreadable (set_hidden_mode)."""
+def assemble(student, work, extra=None, cmake=""):
+    """Writes the grading tree into work/src; returns the notes for the report. `extra`
+    ({relative path: bytes}) and `cmake` (lines for the top CMakeLists.txt): the judge's
+    workers (judge.worker_files)."""
     notes = []
     step_names = [os.path.basename(d) for d in step_dirs(ROOT)]
     files = {}
@@ -115,35 +106,18 @@ def assemble(student, hidden, work, steps):
         if rel not in files and rel.endswith((".cpp", ".cc")):
             notes.append(f"{rel} is new: it is not built (the reference CMake files list the sources)")
         files[rel] = text.encode()
-    # Hidden tests: compiled into their step's test program.
-    by_step = hidden_tests(hidden, {n[:2] for n in step_names})
-    extra = ["", "# Added by tools/grading/grade.py: the instructor's hidden tests."]
-    for number, names in by_step.items():
-        if number not in steps:
-            continue
-        copies = []
-        for k, n in enumerate(names):
-            with open(os.path.join(hidden, n), "rb") as f:
-                files[f"{HIDDEN_DIR}/step{number}_{k}.cpp"] = f.read()
-            copies.append(f"hidden/step{number}_{k}.cpp")
-        sources = " ".join(copies)
-        extra.append(f"if(TARGET test_step{number})\n    target_sources(test_step{number} PRIVATE {sources})\nendif()")
-        notes.append(f"hidden tests for step {number}: {', '.join(names)}")
-    if len(extra) > 2:
-        files["tests/CMakeLists.txt"] += ("\n".join(extra) + "\n").encode()
-    set_hidden_mode(work, 0o600)  # the grader compares and rewrites them
+    files.update(extra or {})
+    if cmake:
+        files["CMakeLists.txt"] += cmake.encode()
     sync_tree(os.path.join(work, "src"), files)
-    set_hidden_mode(work, 0)
     return notes
 
 
 def share_tree(src):
     """The grading tree readable to everyone (the compilers run as the student user; root's
-    umask may be 077), but for the hidden tests (set_hidden_mode)."""
+    umask may be 077)."""
     os.chmod(src, 0o755)
     for d, dirs, files in os.walk(src):
-        if os.path.relpath(d, src) == HIDDEN_DIR:
-            continue
         for n in dirs:
             os.chmod(os.path.join(d, n), 0o755)
         for n in files:

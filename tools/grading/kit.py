@@ -25,15 +25,17 @@ SKIP_DIRS = {".git", "build", "out", "kit", "node_modules", "__pycache__"}
 # The grader's modules: they belong to the instructor's reference tree (they need the
 # solutions). Their end-to-end tests and unit tests stay out with them.
 GRADER = ("grade", "grade_report", "grading_tree", "box", "build_and_run", "errors", "grade_class",
-          "gradescope", "class_bench", "mutants", "safeguards")
+          "gradescope", "class_bench", "mutants", "safeguards", "judge", "mutant_generator",
+          "differential")
 NOT_IN_KIT = ({f"tools/grading/{m}.py" for m in GRADER} | {f"tests/tools/test_{m}.py" for m in GRADER}
               | {"tests/grading_test.py", "tests/class_grading_test.py", "tests/box_test.py",
                  "tests/check_test.py", "tests/lab_test.py"}
               # The attempts behind the measured figures: the kit's pages state results.
               | {"docs/trials.md"})
 # The catalogues of students' mistakes and of the hard cases' safeguards
-# (tools/grading/mutants.py, safeguards.py): patches of the solutions.
-NOT_IN_KIT_DIRS = ("tests/mutants/", "tests/safeguards/")
+# (tools/grading/mutants.py, safeguards.py): patches of the solutions; and the judge (the
+# grader's checker and worker harness).
+NOT_IN_KIT_DIRS = ("tests/mutants/", "tests/safeguards/", "tools/grading/judge/")
 
 
 def in_kit(rel):

@@ -12,6 +12,7 @@ the starter kit leaves them out (kit.py), and this command runs in the reference
 
 usage: ./workbook mutants [N.M | NN | N.M-name ...] [--list] [--check]
        ./workbook mutants --safeguards [NAME ...] [--list] [--check]
+       ./workbook mutants --generate [N.M | NN ...] [--list] [--summary]
   (none: every mutant; N.M: an exercise's; NN: a step's; N.M-name: one mutant, in the
   order given)
   --list   the catalogue
@@ -19,6 +20,9 @@ usage: ./workbook mutants [N.M | NN | N.M-name ...] [--list] [--check]
   --safeguards  the hard cases' safeguards removed instead (tests/safeguards,
            tools/grading/safeguards.py, which ./workbook runs for it): exactly the named
            hard cases must fail
+  --generate  the mechanical mutants of each solution body instead, and the mutation
+           score per exercise (tools/grading/mutant_generator.py, which ./workbook runs
+           for it)
 
 Each mutant is applied to a private copy of the tree (build/mutants/tree, kept between
 runs so that its build is incremental), the exercise's test program alone is built, the

@@ -18,7 +18,7 @@ is lent to that user for the run; otherwise as "nobody" in a user namespace, wit
 further user namespaces.
 Limits (setrlimit, inherited by every process the command starts): wall-clock seconds (the
 whole run), CPU seconds (per process: the wall time times the cores, so a busy loop in
-every thread still stops), address space per process, the size of any file written, and
+every thread still stops, or as given: Limits.cpu), address space per process, the size of any file written, and
 the bytes the command prints on stdout and stderr together. The number of processes and
 threads (a fork bomb): as root a pids cgroup of its own (the kernel does not apply
 RLIMIT_NPROC to root), else RLIMIT_NPROC above the user's current count.
@@ -41,6 +41,7 @@ BOXES_SANDBOX_SYSTEM adds folders the sandbox shows read-only (colon-separated, 
 compiler under /opt).
 """
 import argparse
+import math
 import os
 import resource
 import selectors
@@ -74,8 +75,11 @@ class Limits:
     file_mb: float = 0.0  # any one file written, when it must differ from output_mb (a build)
     processes: int = 256  # processes and threads the command may have at once
     disk_mb: float = 64.0  # all files of a scratch folder together (run's `scratch`, isolated)
+    cpu: float = 0.0  # CPU seconds of each process; 0: the wall time times the cores
 
     def cpu_seconds(self):
+        if self.cpu > 0:
+            return max(1, math.ceil(self.cpu))
         return int(self.seconds * usable_cpus()) + 1
 
 

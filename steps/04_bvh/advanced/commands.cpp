@@ -118,7 +118,7 @@ Vec3 parseTriple(const std::string& text, const std::string& flag) {
     Vec3 v;
     char tail = 0;
     if (std::sscanf(text.c_str(), "%f,%f,%f%c", &v.x, &v.y, &v.z, &tail) != 3 || !isFinite(v))
-        throw InputError(flag + " '" + printable(text) + "': expected three numbers X,Y,Z");
+        throw UsageError(flag + " '" + printable(text) + "': expected three numbers X,Y,Z");
     return v;
 }
 
@@ -128,7 +128,7 @@ int runRays(const RaysCommandOptions& o) {
     std::vector<Ray> rays;
     nlohmann::json j = {{"mesh", o.mesh}, {"kind", o.kind}, {"seed", o.seed}};
     if (!o.eye.empty()) {
-        if (o.kind != "primary") throw InputError("--eye places a camera: only for --kind primary");
+        if (o.kind != "primary") throw UsageError("--eye places a camera: only for --kind primary");
         Vec3 eye = parseTriple(o.eye, "--eye");
         Bounds3f bounds;
         for (const Vec3& p : mesh.positions) bounds.extend(p);

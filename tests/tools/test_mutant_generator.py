@@ -1,0 +1,132 @@
+"""Tests of tools/grading/mutant_generator.py (./workbook mutants --generate): which mutants a
+line makes (operators with spaces around them, not template brackets or comments), that a
+body's keys are stable, and that the schema (every mutant as a case of one switch) is C++
+that compiles, with a broken mutant found by the compiler's line numbers. The slow run over
+the exercises is ./workbook mutants --generate itself."""
+import os
+import shutil
+import subprocess
+import tempfile
+import unittest
+
+from tests.tools import scratch  # noqa: F401  (tempfile's folders: one, removed at exit)
+
+from tools.grading import mutant_generator as gen
+from tools.grading.exercises import parse_file
+
+SOURCE = """#include <algorithm>
+#include <array>
+
+// EXERCISE 1.1: a clamp and a count (1 point)
+int clampCount(std::array<int, 4> values, int lo) {
+    int count = 0;
+    // BEGIN SOLUTION
+    // a comment with a < b and "a string with < inside"
+    for (int i = 0; i < 4; ++i) {
+        if (values[size_t(i)] < lo) continue;
+        count += std::min(values[size_t(i)], 2 * lo);
+    }
+    if (count == 0) return -1;
+    return count;
+    // END SOLUTION
+}
+"""
+
+
+def write_tree():
+    root = tempfile.mkdtemp(prefix="boxes-gen-")
+    os.makedirs(os.path.join(root, "steps", "01_x"))
+    path = os.path.join(root, "steps", "01_x", "x.cpp")
+    with open(path, "w") as f:
+        f.write(SOURCE)
+    return root, path
+
+
+class Lines(unittest.TestCase):
+    def test_comments_and_literals_are_not_code(self):
+        code, still_open = gen.code_mask('a < b; // c < d "e"')
+        self.assertEqual(code.strip(), "a < b;")
+        self.assertFalse(still_open)
+        code, still_open = gen.code_mask('x = "a < b"; /* open')
+        self.assertNotIn("<", code)
+        self.assertTrue(still_open)
+
+    def test_operators_with_spaces_are_mutated_and_template_brackets_are_not(self):
+        line = "    std::vector<int> v; if (a < b && c >= d) x += std::max(y, 2.5f);"
+        found = {(rep, op) for _, _, rep, op, _ in gen.line_mutations(line, gen.code_mask(line)[0])}
+        self.assertIn(("<=", "boundary"), found)
+        self.assertIn((">=", "comparison"), found)  # a < b negated
+        self.assertIn((">", "boundary"), found)  # c >= d
+        self.assertIn(("||", "logical"), found)
+        self.assertIn(("-=", "arithmetic"), found)
+        self.assertIn(("std::min", "min/max"), found)
+        self.assertIn(("0.0f", "constant"), found)
+        self.assertIn(("5.0f", "constant"), found)
+        cols = [c for c, _, _, _, _ in gen.line_mutations(line, gen.code_mask(line)[0])]
+        self.assertNotIn(line.index("<int>"), cols)
+
+    def test_precision_mutants_of_double_and_of_the_template_type(self):
+        line = "    T u = T(double(a) * double(b));"
+        found = [d for _, _, _, op, d in gen.line_mutations(line, line) if op == "precision"]
+        self.assertEqual(len(found), 3)  # two doubles and the T variable
+
+
+class Generate(unittest.TestCase):
+    def setUp(self):
+        self.root, self.path = write_tree()
+        (self.ex,) = parse_file(self.path, self.root)
+
+    def tearDown(self):
+        shutil.rmtree(self.root, ignore_errors=True)
+
+    def test_mutants_of_the_body_only_with_stable_keys(self):
+        mutants = gen.generate(self.path, self.ex)
+        self.assertTrue(mutants)
+        lines = SOURCE.split("\n")
+        for m in mutants:
+            self.assertTrue(self.ex.begin < m.line < self.ex.end)
+            self.assertNotIn("comment", lines[m.line])
+        self.assertEqual([m.key for m in mutants], [m.key for m in gen.generate(self.path, self.ex)])
+        self.assertEqual(len({m.key for m in mutants}), len(mutants))
+        drops = [m for m in mutants if m.operator == "statement"]
+        # The two guards and the += are dropped; the last return is not (it would fall off
+        # the end).
+        self.assertEqual(len(drops), 3)
+        self.assertTrue(any("if (count == 0) return -1;" in m.description for m in drops))
+
+    def test_the_schema_compiles_and_a_broken_mutant_is_found_by_its_line(self):
+        if not shutil.which("g++"):
+            self.skipTest("no g++")
+        mutants = gen.generate(self.path, self.ex)
+        broken = next(m for m in mutants if "count +=" in m.original)
+        broken.mutated = ["        count += this does not compile;"]
+        text, ranges = gen.schema(SOURCE, self.ex, mutants)
+        self.assertIn("switch (boxesGeneratedMutant())", text)
+        with open(self.path, "w") as f:
+            f.write(text)
+        r = subprocess.run(["g++", "-std=c++20", "-fsyntax-only", self.path], capture_output=True, text=True)
+        self.assertNotEqual(r.returncode, 0)
+        lines = gen.error_lines(r.stderr, "steps/01_x/x.cpp")
+        bad = {n for n, (a, b) in ranges.items() if any(a <= l <= b for l in lines)}
+        self.assertEqual(bad, {broken.number})
+        # Without the broken one it compiles, and each mutant runs as its own case.
+        mutants = [m for m in mutants if m is not broken]
+        text, _ = gen.schema(SOURCE, self.ex, mutants)
+        main = text + "\n#include <cstdio>\nint main() { printf(\"%d\\n\", clampCount({1, 5, 3, 9}, 3)); }\n"
+        with open(self.path, "w") as f:
+            f.write(main)
+        exe = os.path.join(self.root, "x")
+        r = subprocess.run(["g++", "-std=c++20", "-O1", "-o", exe, self.path], capture_output=True, text=True)
+        self.assertEqual(r.returncode, 0, r.stderr)
+        outputs = set()
+        for n in [0] + [m.number for m in mutants[:6]]:
+            out = subprocess.run([exe], env=dict(os.environ, BOXES_MUTANT=str(n)), capture_output=True,
+                                 text=True).stdout.strip()
+            outputs.add(out)
+            if n == 0:
+                self.assertEqual(out, "14")  # min(5, 6) + min(3, 6) + min(9, 6)
+        self.assertGreater(len(outputs), 1)
+
+
+if __name__ == "__main__":
+    unittest.main()

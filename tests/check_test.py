@@ -10,6 +10,7 @@ One kit, one build in it (check's own, build/student), the cases in order:
   fresh        `check`: 0 points, every exercise of step 01 "not started", the later steps
                not checked, the next one is 1.1 with its file and line (the line of its
                EXERCISE marker); only step 01's test program and what it needs were built
+  exam         `exam --list`: only the exam program and what it needs were built
   hang         exercise 1.1 that never returns: one "timed out" verdict, no picture render
   correct 1.4  the reference's 1.4 copied into the kit: `check 1.4` passes, and its picture
                is the reference's
@@ -167,6 +168,21 @@ def case_fresh(kit, ex):
           f"fresh kit: only step 01's test program, its program and what they need were built ({extra[:5]})")
 
 
+def case_exam(kit):
+    """`./workbook exam` builds the exam program and what it needs, nothing else."""
+    before = built_outputs(kit)
+    started = time.monotonic()
+    r = subprocess.run(["./workbook", "exam", "--list"], cwd=kit, capture_output=True, text=True, timeout=900)
+    print(f"--- ./workbook exam --list: exit {r.returncode}, {time.monotonic() - started:.1f} s\n"
+          f"{r.stderr[-2000:]}{r.stdout[:300]}", flush=True)
+    check(r.returncode == 0 and re.search(r"^vectors\s", r.stdout, re.M) is not None,
+          f"exam: ./workbook exam --list lists the question kinds, exit {r.returncode}")
+    allowed = needed_for(kit, "exam_practice", "exam/exam_practice") | \
+        {"build.ninja", os.path.join(kit, "build", "student", "CMakeFiles", "cmake.verify_globs")}
+    extra = sorted(built_outputs(kit) - before - allowed)
+    check(not extra, f"exam: only the exam program and what it needs were built ({extra[:5]})")
+
+
 def case_hang(kit, ex):
     """Exercise 1.1 never returns: its tests time out once, and no picture is rendered."""
     e = next(x for x in ex if x.id == "1.1")
@@ -319,6 +335,7 @@ def main():
     ex = exercises(ROOT)
     exercise = next(e for e in ex if e.id == EXERCISE)
     case_fresh(kit, ex)
+    case_exam(kit)
     case_hang(kit, ex)
     case_correct(kit, exercise)
     with open(os.path.join(kit, exercise.path), encoding="utf-8") as f:

@@ -25,8 +25,7 @@ int main(int argc, char** argv) {
     BvhBuildOptions build;
     std::shared_ptr<MeshBvhGeometry> geometry;  // the scene's mesh; none for a scene without one
 
-    // What the step is, for the shell (core/step.hpp): every main fills the same fields,
-    // then adds its own flags, tables and keys.
+    // What the step is, for the shell (core/step.hpp), then its own flags, tables and keys.
     StepProgram step;
     step.name = "04_bvh";
     step.description =

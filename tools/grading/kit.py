@@ -28,7 +28,7 @@ GRADER = ("grade", "grade_report", "grading_tree", "box", "build_and_run", "erro
           "gradescope", "class_bench", "mutants", "safeguards", "judge", "mutant_generator",
           "differential")
 NOT_IN_KIT = ({f"tools/grading/{m}.py" for m in GRADER} | {f"tests/tools/test_{m}.py" for m in GRADER}
-              | {"tests/grading_test.py", "tests/class_grading_test.py", "tests/box_test.py",
+              | {"tests/grading_test.py", "tests/judge_test.py", "tests/class_grading_test.py", "tests/box_test.py",
                  "tests/check_test.py", "tests/lab_test.py"}
               # The attempts behind the measured figures: the kit's pages state results.
               | {"docs/trials.md"})

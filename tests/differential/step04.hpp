@@ -28,6 +28,8 @@ inline std::vector<BuildPrimitive> buildPrimitives(const SplitInput& in) {
         prims.push_back({in.boxes[i], in.boxes[i].centroid(), uint32_t(i)});
     return prims;
 }
+// The same two helpers as tests/step04_support.hpp: these headers build without doctest and
+// the tests' support, for the data generator (generate.cpp) as well as the tests.
 inline Bounds3f centroidBoundsOf(const std::vector<BuildPrimitive>& prims) {
     Bounds3f b;
     for (const auto& p : prims) b.extend(p.centroid);

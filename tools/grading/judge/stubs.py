@@ -140,6 +140,8 @@ def _code_mask(text):
 
 
 def _split_top(text, sep):
+    # exercises._split_top_level's loop, but an empty last part is kept: parse_signature takes
+    # the part after the last ';', which is empty when the text ends with one.
     depth, part, parts = 0, "", []
     for ch in text:
         if ch in "(<[{":

@@ -55,6 +55,8 @@ inline void serveCall(std::span<const Entry> table, const std::string& payload) 
         return;
     }
     Writer w;
+    // Each standard exception its own kind, most derived first: the checker throws the same
+    // type again (checker.hpp), so a test's CHECK_THROWS_AS sees what the student's code threw.
     try {
         handler(r, w);
     } catch (const Malformed& e) {

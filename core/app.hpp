@@ -1,6 +1,6 @@
-// The command line every program of the workbook shares: the common flags and the camera
-// flags, strict numbers, one-line errors and exit codes. What the flags then do is the step
-// shell's (core/step.hpp).
+// The command line every step program shares: the common flags and the camera flags (strict
+// numbers, one-line errors and exit codes: core/command_line.hpp). What the flags then do is
+// the step shell's (core/step.hpp).
 #pragma once
 
 #include <functional>
@@ -8,16 +8,9 @@
 #include <string>
 #include <vector>
 
+#include "core/command_line.hpp"
 #include "core/render.hpp"
 #include "core/scene.hpp"
-
-// CLI11 declared, not included: <CLI/CLI.hpp> costs a file about 9 s of compile time (its
-// parser and the code of its global validators), and most files that include this header
-// never build a command line. Those that do include it themselves.
-namespace CLI {
-class App;
-class Option;
-}  // namespace CLI
 
 namespace boxes {
 
@@ -48,13 +41,6 @@ struct CommonOptions {
 // --eye --look --up --fov --frames --keys --screenshot.
 void addCommonOptions(CLI::App& app, CommonOptions& options, const std::string& defaultScene);
 
-// Parses; a help request prints help and exits 0; a bad flag throws UsageError.
-void parseCommandLine(CLI::App& app, int argc, char** argv);
-
-struct ExitRequest {
-    int code = 0;
-};
-
 // "X,Y,Z" -> vector; throws UsageError naming the flag.
 Vec3 parseVec3(const std::string& text, const std::string& flag);
 
@@ -63,9 +49,5 @@ Camera cameraFromOptions(const CommonOptions& options, const Camera& sceneCamera
 
 // The scene named by --scene, in the image's aspect ratio, data from --data.
 Scene sceneFromOptions(const CommonOptions& options);
-
-// Runs body and turns every error into one line on stderr and an exit code:
-// 0 success, 1 bad input or failure, 2 bad command line, 3 an exercise not implemented.
-int runMain(const std::string& program, const std::function<int()>& body);
 
 }  // namespace boxes

@@ -10,21 +10,6 @@
 
 namespace boxes {
 
-std::string printable(std::string_view text, size_t max) {
-    std::string out;
-    for (size_t i = 0; i < text.size(); ++i) {
-        if (out.size() >= max) return out + "...";
-        unsigned char c = static_cast<unsigned char>(text[i]);
-        if (c < 0x20 || c == 0x7f) {
-            const char* hex = "0123456789abcdef";
-            out += {'\\', 'x', hex[c >> 4], hex[c & 15]};
-        } else {
-            out += char(c);
-        }
-    }
-    return out;
-}
-
 void Mesh::computeVertexNormals() {
     // In double: any float coordinates give a finite, non-subnormal cross product there.
     // In float, a 1e-10 triangle's squared length was subnormal (a normal of length 0.6)

@@ -28,7 +28,20 @@ struct UsageError : InputError {
 // User text quoted in such a message: control bytes escaped as \xNN so the message stays
 // one line (a name with a newline would cut it short), and at most `max` characters (then
 // "...").
-std::string printable(std::string_view text, size_t max = 60);
+inline std::string printable(std::string_view text, size_t max = 60) {
+    std::string out;
+    for (size_t i = 0; i < text.size(); ++i) {
+        if (out.size() >= max) return out + "...";
+        unsigned char c = static_cast<unsigned char>(text[i]);
+        if (c < 0x20 || c == 0x7f) {
+            const char* hex = "0123456789abcdef";
+            out += {'\\', 'x', hex[c >> 4], hex[c & 15]};
+        } else {
+            out += char(c);
+        }
+    }
+    return out;
+}
 
 struct Mesh {
     std::vector<Vec3> positions;

@@ -10,7 +10,8 @@
 #include <iostream>
 #include <memory>
 
-#include "core/app.hpp"
+#include "core/command_line.hpp"
+#include "core/mesh.hpp"  // InputError, UsageError
 #include "exam/answer.hpp"
 #include "exam/mock.hpp"
 #include "exam/questions.hpp"

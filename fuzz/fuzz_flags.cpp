@@ -1,8 +1,9 @@
-// The command line of every step program (core/app.cpp addCommonOptions, parseCommandLine,
-// sceneFromOptions, cameraFromOptions) with the built-in scenes. The input is the argument
-// list, one argument per line. Promise: a scene with a valid camera and sizes in range, or
-// one of the errors runMain turns into one line and an exit code (UsageError, InputError,
-// std::invalid_argument, ExitRequest for --help); never another exception or a crash.
+// The command line of every step program (core/app.cpp addCommonOptions, sceneFromOptions,
+// cameraFromOptions; core/command_line.cpp parseCommandLine) with the built-in scenes. The
+// input is the argument list, one argument per line. Promise: a scene with a valid camera and
+// sizes in range, or one of the errors runMain turns into one line and an exit code
+// (UsageError, InputError, std::invalid_argument, ExitRequest for --help); never another
+// exception or a crash.
 #include <CLI/CLI.hpp>
 #include <sstream>
 #include <vector>

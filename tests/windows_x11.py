@@ -19,7 +19,8 @@ five F2 presses (the panel moved back and forth) and Escape. Checked: the first 
 screen within 100 ms of the window's creation and while the render is still under way (the
 window does not wait for the picture); Escape is honoured in the frame it arrives (counted in
 frames, so a loaded machine cannot make it pass or fail); and the render beside the window
-stops within 100 ms of it (it checks between rows). The times are the window's own, from its
+stops within 100 ms of it (it checks between rows). The two 100 ms budgets hold with a core to
+spare; with a load average above the cores they grow by load / cores (the window's share). The times are the window's own, from its
 creation, so the scene's set-up and the X server's start do not count.
 """
 import json
@@ -97,14 +98,19 @@ def responsive(build, work):
     index, progress, first_ms = frames[0]
     escape_frame = len(RESPONSIVE_KEYS)  # keys[i] arrives before frame i + 1
     problems = []
-    if first_ms > FIRST_FRAME_MS:
-        problems.append(f"the first frame came {first_ms:.1f} ms after the window (more than {FIRST_FRAME_MS})")
+    # The budgets are for a core to spare: on a loaded machine (ctest runs another test
+    # beside this one) the window gets its share of the cores, so they grow with the load.
+    share = max(1.0, os.getloadavg()[0] / (os.cpu_count() or 1))
+    first_budget, stop_budget = FIRST_FRAME_MS * share, STOP_MS * share
+    if first_ms > first_budget:
+        problems.append(f"the first frame came {first_ms:.1f} ms after the window (more than {first_budget:.0f}"
+                        f" at load {os.getloadavg()[0]:.1f})")
     if not 0.0 <= progress < 1.0:
         problems.append(f"the first frame waited for the render (progress {progress})")
     if quit is None or quit[0] != escape_frame:
         problems.append(f"Escape, pressed before frame {escape_frame}, quit at {quit}")
-    if quit and closed is not None and closed - quit[1] > STOP_MS:
-        problems.append(f"the render took {closed - quit[1]:.1f} ms to stop after Escape (more than {STOP_MS})")
+    if quit and closed is not None and closed - quit[1] > stop_budget:
+        problems.append(f"the render took {closed - quit[1]:.1f} ms to stop after Escape (more than {stop_budget:.0f})")
     if problems:
         return "; ".join(problems)
     busy = sum(1 for f in frames if 0.0 <= f[1] < 1.0)

@@ -309,7 +309,10 @@ def prepare(root, folder, hidden_by_step, steps, cache, jobs=2, timeout=3600, sa
         entries = dict(cache, CMAKE_CXX_FLAGS_RELEASE=CHECKER_FLAGS)
         launcher = shutil.which("ccache") if os.environ.get("BOXES_GRADE_CCACHE", "1") != "0" else None
         if launcher:
-            entries["CMAKE_CXX_COMPILER_LAUNCHER"] = launcher
+            # Paths hashed relative to the checkers' sources (ccache's base_dir): every grading
+            # folder, class worker and clone compiles the same files, so they share the objects.
+            entries["CMAKE_CXX_COMPILER_LAUNCHER"] = ";".join(
+                ["env", f"CCACHE_BASEDIR={os.path.realpath(src)}", "CCACHE_NOHASHDIR=1", launcher])
         if not _configured(build, entries):
             say("judge: configuring the checkers (once; later grades reuse them)")
             if not _run_logged(["cmake", "-S", src, "-B", build, "-G", "Ninja"] +

@@ -176,5 +176,49 @@ class Pipes(unittest.TestCase):
             judge.run_pair(checker, worker)
 
 
+class LeftBehind(unittest.TestCase):
+    """What a worker's user left in the shared folders (the grading without bubblewrap): found
+    where that user could have made it, and nothing of anyone else touched."""
+
+    @unittest.skipUnless(os.geteuid() == 0, "files of another user need root")
+    def test_found_where_the_user_could_write(self):
+        import tempfile
+        uid = 59998  # no such user needed: only the files' owner
+        place = tempfile.mkdtemp()
+        os.chmod(place, 0o1777)
+
+        def make(rel, folder=False, mode=None, owner=uid):
+            path = os.path.join(place, rel)
+            if folder:
+                os.mkdir(path)
+            else:
+                open(path, "w").close()
+            if mode is not None:
+                os.chmod(path, mode)
+            os.lchown(path, owner, owner)
+            return path
+
+        make("open", True, 0o777, 0)  # everyone may write: searched
+        make("closed", True, 0o755, 0)  # only its owner may write: not searched...
+        make("closed/open", True, 0o777, 0)  # ...but an open folder below it is
+        make("closed/theirs.txt", owner=0)
+        ours = [make("mine.txt"), make("mydir", True, 0o700), make("open/mine.txt"),
+                make("closed/open/mine.txt")]
+        open(os.path.join(place, "mydir", "inside"), "w").close()
+        link = os.path.join(place, "link")
+        os.symlink("/etc/hostname", link)
+        os.lchown(link, uid, uid)
+        ours.append(link)
+        kept = [make("theirs.txt", owner=0), os.path.join(place, "closed", "theirs.txt")]
+
+        judge._open_below_closed.pop((place,), None)
+        self.assertEqual(judge.open_folders([place]), [os.path.join(place, "closed", "open")])
+        self.assertEqual(judge.remove_left_behind(uid, [place]), len(ours))
+        self.assertEqual([p for p in ours if os.path.lexists(p)], [], "every entry of the user is gone")
+        self.assertEqual([p for p in kept if not os.path.exists(p)], [], "nobody else's entry is touched")
+        self.assertTrue(os.path.exists("/etc/hostname"), "a link is removed, not followed")
+        self.assertEqual(judge.remove_left_behind(uid, [place]), 0, "a second search finds nothing")
+
+
 if __name__ == "__main__":
     unittest.main()

@@ -23,6 +23,7 @@ import os
 import re
 import select
 import shutil
+import stat
 import struct
 import subprocess
 import threading
@@ -666,28 +667,71 @@ def probe(runner, worker_binary, folder_name):
 SHARED_WRITABLE = ("/tmp", "/var/tmp", "/dev/shm")
 
 
+_open_below_closed = {}
+
+
+def _others_may_write(mode):
+    return stat.S_ISDIR(mode) and mode & stat.S_IWOTH
+
+
+def open_folders(places):
+    """The folders below `places` that every user may write although their parent folder is
+    not: found once per process (one walk of the whole tree). A user can create an entry only
+    in a folder it may write, so these and the places themselves are where a worker's files
+    can start; a walk of everything (a clone's build folder in /tmp, tens of thousands of
+    entries) after every case cost a second or two each."""
+    key = tuple(places)
+    if key not in _open_below_closed:
+        found = []
+        for top in places:
+            for d, dirs, _ in os.walk(top):
+                try:
+                    closed = not _others_may_write(os.lstat(d).st_mode)
+                except OSError:
+                    continue
+                for n in dirs:
+                    try:
+                        if closed and _others_may_write(os.lstat(os.path.join(d, n)).st_mode):
+                            found.append(os.path.join(d, n))
+                    except OSError:
+                        pass
+        _open_below_closed[key] = found
+    return _open_below_closed[key]
+
+
 def remove_left_behind(uid, places=SHARED_WRITABLE):
     """Removes what the user `uid` owns in the folders every user may write (links are
-    removed, never followed); the count removed."""
+    removed, never followed); the count removed. It looks where the user could create an
+    entry: in those folders, in the ones below them that every user may write too, and in
+    open_folders' (a folder the user may write through its group or an ACL only is not
+    searched: the student's user has a group of its own and no ACL)."""
     removed = 0
-    for top in places:
-        for d, dirs, names in os.walk(top):
-            for n in dirs + names:
-                path = os.path.join(d, n)
-                try:
-                    info = os.lstat(path)
-                except OSError:
-                    continue
-                if info.st_uid != uid:
-                    continue
-                if n in dirs:
-                    dirs.remove(n)
-                try:
-                    if os.path.isdir(path) and not os.path.islink(path):
-                        shutil.rmtree(path)
-                    else:
-                        os.unlink(path)
-                    removed += 1
-                except OSError:
-                    pass
+    todo = [p for p in list(places) + open_folders(places) if os.path.isdir(p)]
+    seen = set()
+    while todo:
+        folder = todo.pop()
+        if folder in seen:
+            continue
+        seen.add(folder)
+        try:
+            entries = list(os.scandir(folder))
+        except OSError:
+            continue
+        for entry in entries:
+            try:
+                info = entry.stat(follow_symlinks=False)
+            except OSError:
+                continue
+            if info.st_uid != uid:
+                if _others_may_write(info.st_mode):
+                    todo.append(entry.path)
+                continue
+            try:
+                if stat.S_ISDIR(info.st_mode):
+                    shutil.rmtree(entry.path)
+                else:
+                    os.unlink(entry.path)
+                removed += 1
+            except OSError:
+                pass
     return removed

@@ -10,7 +10,10 @@ their home, configures it once (-O1, as the grader builds), then runs COMMANDS a
 at the same time (setpriv, a clean environment): the tour of one step and that step's tests
 (both users), then grading the clone (the first user) while the second writes a starter kit
 and runs the kit's check of that step. Every command must succeed, and after each one the
-user owns nothing new in /tmp, /var/tmp or /dev/shm. Then, with stand-ins for dpkg-query and npm on
+user owns nothing new in /tmp, /var/tmp or /dev/shm. Where ccache is installed the
+administrator first fills the lab's shared compiler cache (docs/instructors.md, "A lab's
+compiler cache") from a clone of its own, and the users' builds read it and cannot write it:
+their first builds take the administrator's objects. Then, with stand-ins for dpkg-query and npm on
 PATH (no network, no install): a missing package names what the administrator runs once;
 npm's log goes nowhere shared (the old /tmp log broke the second user); a failing npm shows
 its output; Ctrl-C during npm leaves nothing behind. The users and their homes are removed
@@ -41,13 +44,15 @@ SHARED_TEMP = ["/tmp", "/var/tmp", "/dev/shm"]
 GRADING = os.path.exists(os.path.join(ROOT, "tools", "grading", "grade.py"))  # not in a kit
 KIT = "kit"  # the starter kit the second user writes beside their clone, in their home
 # -O1, as the grader builds: the users' builds cost less, and what is tested is the same.
-# Where ccache is installed, each user's clone and kit build through a cache of that user's
-# own, in their home (removed with it): the kit's core and tests are the clone's, so its
-# build recompiles only the kit's stubs.
+# Where ccache is installed the project compiles through it with paths relative to the clone
+# (the top CMakeLists.txt), each user into a cache of their own in their home (removed with
+# it), reading the lab's shared cache (LAB_CACHE) that the administrator filled.
 CCACHE = shutil.which("ccache")
-CONFIGURE = (["cmake", "--preset", "release", "-DCMAKE_CXX_FLAGS_RELEASE=-O1 -DNDEBUG"]
-             + ([f"-DCMAKE_CXX_COMPILER_LAUNCHER={CCACHE}", f"-DCMAKE_C_COMPILER_LAUNCHER={CCACHE}"]
-                if CCACHE else []))
+CONFIGURE = ["cmake", "--preset", "release", "-DCMAKE_CXX_FLAGS_RELEASE=-O1 -DNDEBUG"]
+# What the administrator builds into the lab's cache: what the users' first commands build.
+PRIMED = [next(d for d in sorted(os.listdir(os.path.join(ROOT, "steps"))) if d.startswith(STEP + "_")),
+          f"test_step{STEP}"]
+LAB_CACHE = "lab-cache"  # in the work folder
 # What the users run, in order: (name, command, who, where). One line per command. who:
 # "both" at once, or the first or the second user alone; where: the clone, or the kit.
 # The grader's build is a second build of the core (in its sandbox, without the cache): the
@@ -116,14 +121,17 @@ class User:
         self.name, self.home = name, self.pw.pw_dir
         self.clone = os.path.join(self.home, "boxes")
         self.kit = os.path.join(self.home, KIT)
+        self.lab_cache = None
 
     def env(self, **extra):
         """A login's plain environment: no TMPDIR, nothing of this test's."""
         env = dict(PATH="/usr/local/bin:/usr/bin:/bin", HOME=self.home, USER=self.name,
                    LOGNAME=self.name, LANG="C.UTF-8")
-        if CCACHE:  # the user's own cache; paths under the home relative, so clone and kit share it
-            env.update(CCACHE_DIR=os.path.join(self.home, ".ccache"), CCACHE_BASEDIR=self.home,
-                       CCACHE_NOHASHDIR="1", CCACHE_TEMPDIR=os.path.join(self.home, ".ccache", "tmp"))
+        if CCACHE:  # the user's own cache, and the lab's to read (the /etc/ccache.conf line)
+            env.update(CCACHE_DIR=os.path.join(self.home, ".ccache"),
+                       CCACHE_TEMPDIR=os.path.join(self.home, ".ccache", "tmp"))
+            if self.lab_cache:
+                env.update(CCACHE_REMOTE_STORAGE=f"file:{self.lab_cache}|read-only")
         env.update(extra)
         return env
 
@@ -144,14 +152,48 @@ class User:
         return p.returncode, out
 
 
-def make_clone(user):
-    """A fresh clone of this tree (as it is on disk: uncommitted edits too) that the user owns."""
-    subprocess.run(["git", "clone", "--quiet", "--no-hardlinks", ROOT, user.clone], check=True)
+def fresh_clone(dest):
+    """A fresh clone of this tree as it is on disk (uncommitted edits too)."""
+    subprocess.run(["git", "clone", "--quiet", "--no-hardlinks", ROOT, dest], check=True)
     for rel in tracked_files(ROOT):
-        dest = os.path.join(user.clone, rel)
-        os.makedirs(os.path.dirname(dest), exist_ok=True)
-        shutil.copy2(os.path.join(ROOT, rel), dest)
+        path = os.path.join(dest, rel)
+        os.makedirs(os.path.dirname(path), exist_ok=True)
+        shutil.copy2(os.path.join(ROOT, rel), path)
+
+
+def make_clone(user):
+    """A fresh clone that the user owns."""
+    fresh_clone(user.clone)
     subprocess.run(["chown", "-R", f"{user.name}:{user.name}", user.clone], check=True)
+
+
+def fill_lab_cache(work):
+    """The administrator's part (docs/instructors.md, "A lab's compiler cache"): in a clone of
+    their own, builds what the students' first commands build, each object also written to
+    the lab's cache (reshared when the administrator's own cache already has it); the cache's
+    files readable by all, writable by root only. Returns its folder."""
+    cache, clone = os.path.join(work, LAB_CACHE), os.path.join(work, "administrator")
+    shutil.rmtree(clone, ignore_errors=True)
+    shutil.rmtree(cache, ignore_errors=True)
+    os.makedirs(cache, mode=0o755)
+    fresh_clone(clone)
+    env = dict(os.environ, CCACHE_REMOTE_STORAGE=f"file:{cache}|umask=022", CCACHE_RESHARE="1")
+    started = time.monotonic()
+    r = subprocess.run(CONFIGURE, cwd=clone, env=env, capture_output=True, text=True)
+    if r.returncode == 0:
+        r = subprocess.run(["cmake", "--build", "--preset", "release", "--target", *PRIMED], cwd=clone,
+                           env=env, capture_output=True, text=True)
+    check(r.returncode == 0, f"the administrator fills the lab's cache ({time.monotonic() - started:.0f} s; "
+          f"{tail(r.stdout + r.stderr, 5)})")
+    shutil.rmtree(clone, ignore_errors=True)
+    return cache
+
+
+def remote_hits(user):
+    """How many of the user's compiles came from the lab's cache (ccache's statistics)."""
+    rc, out = user.run(["ccache", "--print-stats"])
+    stats = dict(line.split("\t", 1) for line in out.splitlines() if "\t" in line)
+    return int(stats.get("remote_storage_hit", "0"))
 
 
 def tail(text, n=30):
@@ -179,6 +221,11 @@ def scenario(user, first):
         if name == "tour":
             check(os.path.exists(os.path.join(user.clone, "out", "index.html")),
                   f"{user.name}: the tour wrote out/index.html in its clone")
+            if user.lab_cache:
+                hits = remote_hits(user)
+                check(hits > 0, f"{user.name}: the first build took {hits} objects from the lab's cache")
+                rc, _ = user.run(["touch", os.path.join(user.lab_cache, "planted")])
+                check(rc != 0, f"{user.name}: cannot write into the lab's cache")
         if name == "check":
             check(re.search(r"^  total\s+0/\d+\s+points", out, re.M) is not None and
                   f"Next: exercise {int(STEP)}.1:" in out,
@@ -270,9 +317,11 @@ def main():
                 os.chmod(path, 0o644)
                 placed.append(path)
             check(os.lstat(path).st_uid == 0, f"{path} is root's: an ordinary user cannot write it")
+        cache = fill_lab_cache(work) if CCACHE else None
         for name in names:
             remove_user(name)  # a leftover of an interrupted run
             users.append(User(name))
+            users[-1].lab_cache = cache
             make_clone(users[-1])
         threads = [threading.Thread(target=scenario, args=(u, u is users[0])) for u in users]
         started = time.monotonic()

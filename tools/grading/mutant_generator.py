@@ -22,10 +22,11 @@ reference computes on every input the exercise's contract allows) in
 tests/mutants/equivalent.json, one line of why each; the score leaves the equivalent ones
 out. A mutant that does not compile is not counted.
 
-usage: ./workbook mutants --generate [N.M | NN ...] [--list] [--summary] [--timeout S] [--jobs N]
+usage: ./workbook mutants --generate [N.M | NN ...] [--list] [--summary | --markdown] [--timeout S] [--jobs N]
   (none: every exercise; N.M: one; NN: a step's)
   --list     the mutants, without running them
   --summary  the table of the last runs (build/mutants/generated.json), without running
+  --markdown the same table in Markdown (as docs/reliability.md shows it)
   --timeout  at most these seconds for one mutant's run of the exercise's tests (default 30;
              a run may last ten times the reference's, at least 5 s)
   --jobs     compile jobs of the builds (default 2)
@@ -458,12 +459,14 @@ def score_row(ex_id, entry, equivalent):
     return len(outcome), stillborn, killed, len(eq), left, score
 
 
-def print_summary(results, equivalent, chosen=None, descriptions=None):
+def print_summary(results, equivalent, chosen=None, descriptions=None, markdown=False):
     rows = []
     for ex_id in sorted(results, key=lambda s: tuple(int(x) for x in s.split("."))):
         if chosen and ex_id not in chosen:
             continue
         rows.append((ex_id,) + score_row(ex_id, results[ex_id], equivalent))
+    if markdown:
+        return print_markdown(rows)
     print(f"{'exercise':<9} {'mutants':>7} {'no build':>8} {'killed':>6} {'equivalent':>10} "
           f"{'survived':>8} {'score':>7}")
     for ex_id, n, still, killed, eq, left, score in rows:
@@ -483,6 +486,20 @@ def print_summary(results, equivalent, chosen=None, descriptions=None):
             print(f"  {k}: {d}")
     low = [r[0] for r in rows if r[6] < 95.0]
     return 1 if low else 0
+
+
+def print_markdown(rows):
+    """The table of print_summary as Markdown (docs/reliability.md shows it)."""
+    print("| exercise | generated | stillborn | killed | equivalent | survived | score |")
+    print("|---|---:|---:|---:|---:|---:|---:|")
+    for ex_id, n, still, killed, eq, left, score in rows:
+        print(f"| {ex_id} | {n} | {still} | {killed} | {eq} | {len(left)} | {score:.1f}% |")
+    total_k = sum(r[3] for r in rows)
+    total_left = sum(len(r[5]) for r in rows)
+    print(f"| all | {sum(r[1] for r in rows)} | {sum(r[2] for r in rows)} | {total_k} | "
+          f"{sum(r[4] for r in rows)} | {total_left} | "
+          f"{100.0 * total_k / max(1, total_k + total_left):.1f}% |")
+    return 1 if any(r[6] < 95.0 for r in rows) else 0
 
 
 def main(argv):
@@ -505,7 +522,7 @@ def main(argv):
         args = [a for a in args if a != argv[i + 1]]
         flags.remove(name)
     for f in flags:
-        if f not in ("--list", "--summary", "-h", "--help"):
+        if f not in ("--list", "--summary", "--markdown", "-h", "--help"):
             print(f"mutants --generate: unknown option '{f}'", file=sys.stderr)
             return 2
     if "-h" in flags or "--help" in flags:
@@ -514,8 +531,9 @@ def main(argv):
     all_ex = [e for e in exercises(ROOT) if e.begin >= 0 and e.end >= 0]
     chosen = select(all_ex, args)
     equivalent = load_equivalent()
-    if "--summary" in flags:
-        return print_summary(load_results(), equivalent, {e.id for e in chosen} if args else None)
+    if "--summary" in flags or "--markdown" in flags:
+        return print_summary(load_results(), equivalent, {e.id for e in chosen} if args else None,
+                             markdown="--markdown" in flags)
     generated = {e.id: generate(os.path.join(ROOT, e.path), e) for e in chosen}
     if "--list" in flags:
         for e in chosen:

@@ -487,7 +487,7 @@ TEST_SUITE("exercise 1.5") {
         CHECK(double(hitLower->u) == doctest::Approx(0.5).epsilon(1e-6));
         CHECK(double(hitLower->v) == doctest::Approx(0.5).epsilon(1e-6));
     }
-    TEST_CASE("hard case: an edge function that rounds to zero is recomputed whichever of u, v, w it is") {
+    TEST_CASE("hard case: an edge function that rounds to zero is recomputed as v and as w too") {
         // The two triangles above with their vertices rotated (the same triangles, the same
         // winding): the shared edge's function, u there, is v for (c, a, b) and w for
         // (b, c, a). Each must be recomputed in double, or both triangles report the ray.

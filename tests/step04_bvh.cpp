@@ -159,7 +159,8 @@ TEST_SUITE("exercise 4.3") {
         CHECK(left == 0);
         CHECK(cost == kInfinity<float>);
     }
-    TEST_CASE("binned SAH: centroids on a line along one axis are split (the others without extent)") {
+    TEST_CASE(
+        "binned SAH: centroids on a line along one axis are split (the others without extent)") {
         // Unit boxes at 0, 1 and 4 along the axis: centroid extent 4, and with 4 bins a bin
         // scale of exactly 1. Node area 2 (5 + 1 + 5) = 22; the best split {0, 1} | {4}
         // costs 1 + (10 * 2 + 6 * 1) / 22.
@@ -175,7 +176,8 @@ TEST_SUITE("exercise 4.3") {
             BvhBuildOptions o = optionsFor(BvhBuilder::BinnedSah);
             o.bins = 4;
             float cost = 0.0f;
-            size_t left = partitionBinnedSah(prims, boundsOf(prims), centroidBounds(prims), o, cost);
+            size_t left =
+                partitionBinnedSah(prims, boundsOf(prims), centroidBounds(prims), o, cost);
             REQUIRE(left == 2);
             CHECK(prims[2].centroid[axis] == 4.5f);
             CHECK(cost == doctest::Approx(1.0 + 26.0 / 22.0).epsilon(1e-6));
@@ -196,7 +198,8 @@ TEST_SUITE("exercise 4.3") {
         for (size_t n : {2u, 3u}) {
             INFO(n << " points");
             std::vector<Bounds3f> boxes;
-            for (size_t i = 0; i < n; ++i) boxes.push_back({Vec3(float(i), 0, 0), Vec3(float(i), 0, 0)});
+            for (size_t i = 0; i < n; ++i)
+                boxes.push_back({Vec3(float(i), 0, 0), Vec3(float(i), 0, 0)});
             auto prims = primitivesOf(boxes);
             float cost = 0.0f;
             size_t left = partitionBinnedSah(prims, boundsOf(prims), centroidBounds(prims),

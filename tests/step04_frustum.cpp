@@ -58,7 +58,8 @@ TEST_SUITE("exercise 4.6") {
         for (const auto& plane : f.planes)
             CHECK(glm::dot(plane.normal, Vec3(15, 0, -10)) + plane.d >= 0.0f);
     }
-    TEST_CASE("frustum: the side planes face inwards for an eye far from the origin and far = 10^5") {
+    TEST_CASE(
+        "frustum: the side planes face inwards for an eye far from the origin and far = 10^5") {
         // A point to orient the side planes by must lie clearly inside: one a few millionths
         // in front of an eye at z = 1000 (float's spacing there is 6e-5) rounds to the eye,
         // which lies on every side plane and orients none of them.

@@ -412,7 +412,8 @@ TEST_SUITE("exercise 5.9") {
             CHECK(r.advance(c.budget) == 0);  // complete: nothing more to do
         }
     }
-    TEST_CASE("incremental renderer: a clock far from its start (days of uptime) keeps the budget") {
+    TEST_CASE(
+        "incremental renderer: a clock far from its start (days of uptime) keeps the budget") {
         // A steady clock may count from boot: 2^20 s (12 days) and 3 ms. Float keeps only
         // eighths of a second there, so a start or a line's start held in float is off by
         // milliseconds and the frame holds 6 lines, or 8, instead of floor(15 / 2) = 7.

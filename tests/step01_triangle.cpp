@@ -264,6 +264,14 @@ TEST_SUITE("exercise 1.4") {
     TEST_CASE("Moller-Trumbore: hard cases") {
         checkHardCases(TriangleTest::MollerTrumbore);
     }
+    TEST_CASE("Moller-Trumbore: a determinant that overflows float is no hit at t = 0") {
+        // An edge 3e38 long: det = -6e38, -inf in float, and 1 / det = -0 would make u, v
+        // and t all zero, a hit at the origin. The ray starts 0.1 above the triangle's plane
+        // (z = 0) and leaves it: a miss, as in double (t = -0.1 there).
+        const Triangled huge{{0, 0, 0}, {3e38, 0, 0}, {0, 2, 0}};
+        CHECK_FALSE(intersectMollerTrumbore(Ray({0, 0.1f, 0.1f}, {0, 0, 1}), cast<float>(huge)));
+        CHECK_FALSE(intersectMollerTrumbore(Rayd({0, 0.1, 0.1}, {0, 0, 1}), huge));
+    }
     TEST_CASE("Moller-Trumbore: a point past the first edge (u < 0) is a miss") {
         // Straight down at (-0.2, 0.5): u = -0.2, v = 0.5, u + v <= 1.
         CHECK_FALSE(intersectMollerTrumbore(Rayd({-0.2, 0.5, 1}, {0, 0, -1}), kUnit));
@@ -478,6 +486,27 @@ TEST_SUITE("exercise 1.5") {
         // within rounding: weights of c and b about 1/2 each.
         CHECK(double(hitLower->u) == doctest::Approx(0.5).epsilon(1e-6));
         CHECK(double(hitLower->v) == doctest::Approx(0.5).epsilon(1e-6));
+    }
+    TEST_CASE("hard case: an edge function that rounds to zero is recomputed as v and as w too") {
+        // The two triangles above with their vertices rotated (the same triangles, the same
+        // winding): the shared edge's function, u there, is v for (c, a, b) and w for
+        // (b, c, a). Each must be recomputed in double, or both triangles report the ray.
+        const float e = std::ldexp(1.0f, -23);
+        const Vec3 b(1.0f, 1.0f + e, 1.0f), c(-(1.0f + e), -(1.0f + 2.0f * e), 1.0f);
+        const Vec3 upperA(-1.0f, 1.0f, 1.0f), lowerA(1.0f, -1.0f, 1.0f);
+        const Ray ray(Vec3(0.0f), Vec3(0.0f, 0.0f, 1.0f));
+        struct Rotation {
+            const char* edge;
+            Triangle upper, lower;
+        };
+        for (const Rotation& r : {Rotation{"v", {c, upperA, b}, {b, lowerA, c}},
+                                  Rotation{"w", {b, c, upperA}, {c, b, lowerA}}}) {
+            INFO("the shared edge's function is " << r.edge);
+            CHECK_FALSE(intersectWatertight(ray, r.upper).has_value());
+            auto hit = intersectWatertight(ray, r.lower);
+            REQUIRE(hit.has_value());
+            CHECK(hit->t == 1.0f);
+        }
     }
 }
 

@@ -159,6 +159,69 @@ TEST_SUITE("exercise 4.3") {
         CHECK(left == 0);
         CHECK(cost == kInfinity<float>);
     }
+    TEST_CASE(
+        "binned SAH: centroids on a line along one axis are split (the others without extent)") {
+        // Unit boxes at 0, 1 and 4 along the axis: centroid extent 4, and with 4 bins a bin
+        // scale of exactly 1. Node area 2 (5 + 1 + 5) = 22; the best split {0, 1} | {4}
+        // costs 1 + (10 * 2 + 6 * 1) / 22.
+        for (int axis = 0; axis < 3; ++axis) {
+            INFO("the line along axis " << axis);
+            std::vector<Bounds3f> boxes;
+            for (float at : {4.0f, 0.0f, 1.0f}) {
+                Vec3 lo(0.0f);
+                lo[axis] = at;
+                boxes.push_back(unitBoxAt(lo));
+            }
+            auto prims = primitivesOf(boxes);
+            BvhBuildOptions o = optionsFor(BvhBuilder::BinnedSah);
+            o.bins = 4;
+            float cost = 0.0f;
+            size_t left =
+                partitionBinnedSah(prims, boundsOf(prims), centroidBounds(prims), o, cost);
+            REQUIRE(left == 2);
+            CHECK(prims[2].centroid[axis] == 4.5f);
+            CHECK(cost == doctest::Approx(1.0 + 26.0 / 22.0).epsilon(1e-6));
+        }
+    }
+    TEST_CASE("binned SAH: two primitives apart only along z are split") {
+        // Node [0,1] x [0,1] x [0,4], area 18: cost 1 + (6 + 6) / 18.
+        auto prims = primitivesOf({unitBoxAt({0, 0, 3}), unitBoxAt({0, 0, 0})});
+        float cost = 0.0f;
+        size_t left = partitionBinnedSah(prims, boundsOf(prims), centroidBounds(prims),
+                                         optionsFor(BvhBuilder::BinnedSah), cost);
+        REQUIRE(left == 1);
+        CHECK(prims[0].centroid.z == 0.5f);
+        CHECK(cost == doctest::Approx(1.0 + 12.0 / 18.0).epsilon(1e-6));
+    }
+    TEST_CASE("binned SAH: points on a line (a node without area) give no split, not a NaN cost") {
+        // Every cost would be 0 / 0: no split, for two primitives and for more.
+        for (size_t n : {2u, 3u}) {
+            INFO(n << " points");
+            std::vector<Bounds3f> boxes;
+            for (size_t i = 0; i < n; ++i)
+                boxes.push_back({Vec3(float(i), 0, 0), Vec3(float(i), 0, 0)});
+            auto prims = primitivesOf(boxes);
+            float cost = 0.0f;
+            size_t left = partitionBinnedSah(prims, boundsOf(prims), centroidBounds(prims),
+                                             optionsFor(BvhBuilder::BinnedSah), cost);
+            CHECK(left == 0);
+            CHECK(cost == kInfinity<float>);
+        }
+    }
+    TEST_CASE("binned SAH: boxes whose areas overflow float give no split, not a NaN-priced one") {
+        // Half-size 10^20: each area is about 2.4e41, beyond float's 3.4e38, so every plane
+        // prices inf / inf = NaN and none is cheaper than no split.
+        test::FpTrapsOff nanOnPurpose;  // the NaN prices are the case under test
+        std::vector<Bounds3f> boxes;
+        for (float x : {0.0f, 3e20f, 6e20f, 9e20f})
+            boxes.push_back({Vec3(x - 1e20f, -1e20f, -1e20f), Vec3(x + 1e20f, 1e20f, 1e20f)});
+        auto prims = primitivesOf(boxes);
+        float cost = 0.0f;
+        size_t left = partitionBinnedSah(prims, boundsOf(prims), centroidBounds(prims),
+                                         optionsFor(BvhBuilder::BinnedSah), cost);
+        CHECK(left == 0);
+        CHECK(cost == kInfinity<float>);
+    }
     TEST_CASE("binned SAH: structure and a cost close to the full sweep") {
         Mesh m = triangleSoup(4000, 9);
         for (int bins : {4, 16, 64}) {

@@ -195,4 +195,12 @@ TEST_SUITE("exercise 4.5") {
         CHECK_FALSE(any);
         CHECK(calls == 0);
     }
+    TEST_CASE("any hit: an empty tree blocks nothing") {
+        // A scene without triangles: no root to read, no primitive to test.
+        int calls = 0;
+        Ray ray(Vec3(0.0f), Vec3(0, 0, 1), 0.0f, 10.0f);
+        CHECK_FALSE(
+            traverseAny(Bvh{}, TraversalRay(ray), [&](uint32_t, float) { return ++calls > 0; }));
+        CHECK(calls == 0);
+    }
 }

@@ -58,6 +58,19 @@ TEST_SUITE("exercise 4.6") {
         for (const auto& plane : f.planes)
             CHECK(glm::dot(plane.normal, Vec3(15, 0, -10)) + plane.d >= 0.0f);
     }
+    TEST_CASE(
+        "frustum: the side planes face inwards for an eye far from the origin and far = 10^5") {
+        // A point to orient the side planes by must lie clearly inside: one a few millionths
+        // in front of an eye at z = 1000 (float's spacing there is 6e-5) rounds to the eye,
+        // which lies on every side plane and orients none of them.
+        Camera c = frustumCamera();
+        c.eye = Vec3(0, 0, 1000);
+        Frustum f = makeFrustum(c, 1.0f, 1e5f);
+        for (size_t i = 0; i < 6; ++i) {
+            INFO("plane " << i);
+            CHECK(glm::dot(f.planes[i].normal, Vec3(0, 0, 950)) + f.planes[i].d > 0.0f);
+        }
+    }
     TEST_CASE("frustum: near and far must satisfy 0 < near < far") {
         Camera c;
         CHECK_THROWS_AS(makeFrustum(c, 0.0f, 1.0f), std::invalid_argument);

@@ -412,6 +412,21 @@ TEST_SUITE("exercise 5.9") {
             CHECK(r.advance(c.budget) == 0);  // complete: nothing more to do
         }
     }
+    TEST_CASE(
+        "incremental renderer: a clock far from its start (days of uptime) keeps the budget") {
+        // A steady clock may count from boot: 2^20 s (12 days) and 3 ms. Float keeps only
+        // eighths of a second there, so a start or a line's start held in float is off by
+        // milliseconds and the frame holds 6 lines, or 8, instead of floor(15 / 2) = 7.
+        FakeLines f;
+        f.now = 1048576.0 + 3 * kMs;
+        f.cost = 2 * kMs;
+        IncrementalRenderer r(
+            4, 21, [&](Image&, int) { f.now += f.cost; }, f.clock());
+        CHECK(r.advance(15 * kMs) == 7);
+        CHECK(r.advance(15 * kMs) == 7);
+        CHECK(r.advance(15 * kMs) == 7);
+        CHECK(r.complete());
+    }
     TEST_CASE("incremental renderer: a line more expensive than the budget still advances") {
         // 20 ms a line, 15 ms a frame: one line per frame, or the image never progresses.
         FakeLines f;

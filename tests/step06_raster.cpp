@@ -374,6 +374,16 @@ TEST_SUITE("exercise 6.8") {
         // w = 5.5, 0.5 behind the stored 5: a bias of 1 accepts it as the same surface.
         CHECK(litByShadowMap(topRightMap(), Vec3(0.5f, 0.5f, -5.5f), 1.0));
     }
+    TEST_CASE("shadow map lookup: a point less than one unit from the light is shadowed too") {
+        // The light's near plane at 0.1: (0.25, 0.25, -0.8) has w = 0.8, screen (1.3125,
+        // 0.6875), texel (1, 0), where an occluder at depth 0.5 lies between it and the light.
+        ShadowMap map;
+        map.size = 2;
+        map.viewProjection = glm::perspective(glm::radians(90.0), 1.0, 0.1, 100.0);
+        map.depth = {kInfinity<float>, 0.5f, kInfinity<float>, kInfinity<float>};
+        CHECK_FALSE(litByShadowMap(map, Vec3(0.25f, 0.25f, -0.8f), 0.0));
+        CHECK(litByShadowMap(map, Vec3(0.25f, 0.25f, -0.8f), 0.5));  // 0.8 - 0.5 <= 0.5
+    }
     TEST_CASE("shadow map lookup: the texel row counts from the top") {
         // Up and right (y > 0) is row 0: the occluder's texel; down and right is row 1, empty.
         CHECK_FALSE(litByShadowMap(topRightMap(), Vec3(2.0f, 2.0f, -10.0f), 0.0));

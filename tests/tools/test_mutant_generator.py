@@ -8,6 +8,7 @@ import shutil
 import subprocess
 import tempfile
 import unittest
+import unittest.mock
 
 from tests.tools import scratch  # noqa: F401  (tempfile's folders: one, removed at exit)
 
@@ -126,6 +127,29 @@ class Generate(unittest.TestCase):
             if n == 0:
                 self.assertEqual(out, "14")  # min(5, 6) + min(3, 6) + min(9, 6)
         self.assertGreater(len(outputs), 1)
+
+
+class Score(unittest.TestCase):
+    def test_the_score_leaves_out_the_equivalent_and_the_table_says_so(self):
+        # 1.1: 18 killed, 2 survived, one of them argued equivalent, 1 stillborn: 18 / 19.
+        outcome = {f"1.1-k{i}": ("killed", "") for i in range(18)}
+        outcome.update({"1.1-eq": ("survived", ""), "1.1-left": ("survived", ""),
+                        "1.1-nb": ("stillborn", "does not compile")})
+        results = {"1.1": {"outcome": outcome}, "1.2": {"outcome": {"1.2-a": ("killed", "")}}}
+        equivalent = {"1.1-eq": {"exercise": "1.1", "why": "the same on every input"}}
+        n, still, killed, eq, left, score = gen.score_row("1.1", results["1.1"], equivalent)
+        self.assertEqual((n, still, killed, eq, left), (21, 1, 18, 1, ["1.1-left"]))
+        self.assertAlmostEqual(score, 100.0 * 18 / 19)
+        with unittest.mock.patch("builtins.print") as shown:
+            status = gen.print_summary(results, equivalent, markdown=True)
+        lines = [c.args[0] for c in shown.call_args_list]
+        self.assertIn("| 1.1 | 21 | 1 | 18 | 1 | 1 | 94.7% |", lines)
+        self.assertIn("| 1.2 | 1 | 0 | 1 | 0 | 0 | 100.0% |", lines)
+        self.assertIn("| all | 22 | 1 | 19 | 1 | 1 | 95.0% |", lines)
+        self.assertEqual(status, 1)  # 1.1 is under 95%
+        equivalent["1.1-left"] = {"exercise": "1.1", "why": "argued too"}
+        with unittest.mock.patch("builtins.print"):
+            self.assertEqual(gen.print_summary(results, equivalent, markdown=True), 0)
 
 
 if __name__ == "__main__":

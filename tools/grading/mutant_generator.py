@@ -22,11 +22,14 @@ reference computes on every input the exercise's contract allows) in
 tests/mutants/equivalent.json, one line of why each; the score leaves the equivalent ones
 out. A mutant that does not compile is not counted.
 
-usage: ./workbook mutants --generate [N.M | NN ...] [--list] [--summary] [--timeout S]
+usage: ./workbook mutants --generate [N.M | NN ...] [--list] [--summary | --markdown] [--timeout S] [--jobs N]
   (none: every exercise; N.M: one; NN: a step's)
   --list     the mutants, without running them
   --summary  the table of the last runs (build/mutants/generated.json), without running
-  --timeout  seconds for one mutant's run of the exercise's tests (default 30)
+  --markdown the same table in Markdown (as docs/reliability.md shows it)
+  --timeout  at most these seconds for one mutant's run of the exercise's tests (default 30;
+             a run may last ten times the reference's, at least 5 s)
+  --jobs     compile jobs of the builds (default 2)
 
 How: all the mutants of an exercise are compiled at once into a private copy of the tree
 (mutants.py's, build/mutants/tree), each as one case of a switch over copies of the
@@ -49,7 +52,7 @@ from dataclasses import dataclass, field
 from . import ROOT
 from .. import build as cmake
 from .exercises import case_results, exercises
-from .mutants import build_dir, private_tree, release_tree
+from .mutants import private_tree, release_tree
 
 EQUIVALENT = "tests/mutants/equivalent.json"
 RESULTS = os.path.join("build", "mutants", "generated.json")
@@ -311,24 +314,29 @@ CHECKED = {"CMAKE_CXX_FLAGS": "-D_GLIBCXX_ASSERTIONS", "CMAKE_CXX_FLAGS_RELEASE"
 
 def build_tree(tree):
     """The private tree's build: mutants.py's (no step programs, no link-time optimisation)
-    with CHECKED."""
+    with CHECKED, in a folder of its own (build/generated): the written catalogue's build
+    keeps its flags, so running one after the other rebuilds nothing. No test discovery:
+    the suites are run here, not by ctest, and discovery would run the program after each
+    link."""
     t = release_tree(tree)
+    t.build = os.path.join(tree, "build", "generated")
     t.cache.update(CHECKED)
+    t.cache["BOXES_TESTS_DISCOVER"] = "OFF"
     return t
 
 
-def build(btree, step, log):
+def build(btree, step, log, jobs):
     """Builds the step's test program: (ok, the compiler's output)."""
-    r = cmake.build(btree, [f"test_step{step:02d}"], jobs=2, log=log)
+    r = cmake.build(btree, [f"test_step{step:02d}"], jobs=jobs, log=log)
     log.flush()
     return r.ok, r.output
 
 
-def run_tests(tree, step, exercise, number, timeout):
+def run_tests(btree, step, exercise, number, timeout):
     """(killed, how): the exercise's suite with mutant `number` selected."""
     from ..check import run_suite  # noqa: PLC0415 (the student loop's runner)
 
-    binary = os.path.join(build_dir(tree), "tests", f"test_step{step:02d}")
+    binary = os.path.join(btree.build, "tests", f"test_step{step:02d}")
     os.environ[SELECTOR] = str(number)
     try:
         kind, data, detail = run_suite(binary, exercise, timeout)
@@ -368,9 +376,11 @@ def save_results(results, root=ROOT):
     os.replace(path + ".new", path)
 
 
-def run_exercise(tree, btree, ex, mutants, timeout, log, say):
+def run_exercise(tree, btree, ex, mutants, timeout, log, say, jobs=2):
     """Every mutant of one exercise: {key: (status, how)}, status killed, survived,
-    stillborn (does not compile) or reference (the reference itself fails)."""
+    stillborn (does not compile) or reference (the reference itself fails). A mutant's run
+    may last ten times the reference's (at least 5 s, at most `timeout`): a mutant that
+    loops costs seconds, not the whole timeout."""
     rel = ex.path
     path = os.path.join(tree, rel)
     with open(path, encoding="utf-8") as f:
@@ -384,7 +394,7 @@ def run_exercise(tree, btree, ex, mutants, timeout, log, say):
                 with open(path, "w", encoding="utf-8") as f:
                     f.write(text)
                 say(f"[generated] {ex.id}: building {len(chunk)} mutants (one switch)")
-                ok, output = build(btree, ex.step, log)
+                ok, output = build(btree, ex.step, log, jobs)
                 if ok:
                     break
                 bad = set()
@@ -405,14 +415,16 @@ def run_exercise(tree, btree, ex, mutants, timeout, log, say):
                     break
             if not chunk:
                 continue
-            killed, how = run_tests(tree, ex.step, ex.id, 0, timeout)
+            t0 = time.monotonic()
+            killed, how = run_tests(btree, ex.step, ex.id, 0, timeout)
+            limit = min(timeout, max(5.0, 10 * (time.monotonic() - t0)))
             if killed:
                 for m in chunk:
                     outcome[m.key] = ("reference", how)
                 say(f"[generated] {ex.id}: the reference fails its own tests ({how}); skipped")
                 continue
             for m in chunk:
-                killed, how = run_tests(tree, ex.step, ex.id, m.number, timeout)
+                killed, how = run_tests(btree, ex.step, ex.id, m.number, limit)
                 outcome[m.key] = ("killed" if killed else "survived", how)
     finally:
         with open(path, "w", encoding="utf-8") as f:
@@ -447,12 +459,14 @@ def score_row(ex_id, entry, equivalent):
     return len(outcome), stillborn, killed, len(eq), left, score
 
 
-def print_summary(results, equivalent, chosen=None, descriptions=None):
+def print_summary(results, equivalent, chosen=None, descriptions=None, markdown=False):
     rows = []
     for ex_id in sorted(results, key=lambda s: tuple(int(x) for x in s.split("."))):
         if chosen and ex_id not in chosen:
             continue
         rows.append((ex_id,) + score_row(ex_id, results[ex_id], equivalent))
+    if markdown:
+        return print_markdown(rows)
     print(f"{'exercise':<9} {'mutants':>7} {'no build':>8} {'killed':>6} {'equivalent':>10} "
           f"{'survived':>8} {'score':>7}")
     for ex_id, n, still, killed, eq, left, score in rows:
@@ -474,20 +488,41 @@ def print_summary(results, equivalent, chosen=None, descriptions=None):
     return 1 if low else 0
 
 
+def print_markdown(rows):
+    """The table of print_summary as Markdown (docs/reliability.md shows it)."""
+    print("| exercise | generated | stillborn | killed | equivalent | survived | score |")
+    print("|---|---:|---:|---:|---:|---:|---:|")
+    for ex_id, n, still, killed, eq, left, score in rows:
+        print(f"| {ex_id} | {n} | {still} | {killed} | {eq} | {len(left)} | {score:.1f}% |")
+    total_k = sum(r[3] for r in rows)
+    total_left = sum(len(r[5]) for r in rows)
+    print(f"| all | {sum(r[1] for r in rows)} | {sum(r[2] for r in rows)} | {total_k} | "
+          f"{sum(r[4] for r in rows)} | {total_left} | "
+          f"{100.0 * total_k / max(1, total_k + total_left):.1f}% |")
+    return 1 if any(r[6] < 95.0 for r in rows) else 0
+
+
 def main(argv):
     args = [a for a in argv if not a.startswith("-")]
     flags = [a for a in argv if a.startswith("-") and a != "--generate"]
-    timeout = 30.0
-    if "--timeout" in flags:
-        i = argv.index("--timeout")
-        if i + 1 >= len(argv):
-            print("mutants --generate: --timeout needs seconds", file=sys.stderr)
+    timeout, jobs = 30.0, 2
+    for name in ("--timeout", "--jobs"):
+        if name not in flags:
+            continue
+        i = argv.index(name)
+        try:
+            value = float(argv[i + 1]) if name == "--timeout" else int(argv[i + 1])
+        except (IndexError, ValueError):
+            print(f"mutants --generate: {name} needs a number", file=sys.stderr)
             return 2
-        timeout = float(argv[i + 1])
+        if value <= 0:
+            print(f"mutants --generate: {name} needs a positive number", file=sys.stderr)
+            return 2
+        timeout, jobs = (value, jobs) if name == "--timeout" else (timeout, value)
         args = [a for a in args if a != argv[i + 1]]
-        flags.remove("--timeout")
+        flags.remove(name)
     for f in flags:
-        if f not in ("--list", "--summary", "-h", "--help"):
+        if f not in ("--list", "--summary", "--markdown", "-h", "--help"):
             print(f"mutants --generate: unknown option '{f}'", file=sys.stderr)
             return 2
     if "-h" in flags or "--help" in flags:
@@ -496,8 +531,9 @@ def main(argv):
     all_ex = [e for e in exercises(ROOT) if e.begin >= 0 and e.end >= 0]
     chosen = select(all_ex, args)
     equivalent = load_equivalent()
-    if "--summary" in flags:
-        return print_summary(load_results(), equivalent, {e.id for e in chosen} if args else None)
+    if "--summary" in flags or "--markdown" in flags:
+        return print_summary(load_results(), equivalent, {e.id for e in chosen} if args else None,
+                             markdown="--markdown" in flags)
     generated = {e.id: generate(os.path.join(ROOT, e.path), e) for e in chosen}
     if "--list" in flags:
         for e in chosen:
@@ -534,7 +570,7 @@ def main(argv):
         for e in chosen:
             t0 = time.monotonic()
             mutants = generated[e.id]
-            outcome = run_exercise(tree, btree, e, mutants, timeout, log, say)
+            outcome = run_exercise(tree, btree, e, mutants, timeout, log, say, jobs)
             results[e.id] = {
                 "outcome": outcome,
                 "descriptions": {m.key: m.description for m in mutants},

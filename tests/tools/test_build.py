@@ -30,6 +30,21 @@ class Commands(unittest.TestCase):
         self.assertEqual(build.build_command(tree, ["test_step01", "x.o"], jobs=2),
                          ["cmake", "--build", "/w/build", "--target", "test_step01", "x.o", "--", "-j2"])
 
+    def test_a_configured_ninja_tree_is_built_by_ninja_itself(self):
+        with tempfile.TemporaryDirectory() as tmp:
+            ninja = os.path.join(tmp, "ninja")
+            with open(ninja, "w") as f:
+                f.write("#!/bin/sh\n")
+            os.chmod(ninja, 0o755)
+            with open(os.path.join(tmp, "CMakeCache.txt"), "w") as f:
+                f.write(f"CMAKE_MAKE_PROGRAM:FILEPATH={ninja}\n")
+            tree = build.Tree("/w", tmp)
+            # No build.ninja yet: cmake --build, as before.
+            self.assertEqual(build.build_command(tree, ["a"])[:2], ["cmake", "--build"])
+            open(os.path.join(tmp, "build.ninja"), "w").close()
+            self.assertEqual(build.build_command(tree, ["test_step01"], jobs=2),
+                             [ninja, "-C", tmp, "test_step01", "-j2"])
+
     def test_configured_means_build_files_and_the_settings_wanted(self):
         with tempfile.TemporaryDirectory() as tmp:
             tree = build.Tree(tmp, tmp, cache={"BOXES_GRADING": "ON"})

@@ -133,9 +133,23 @@ def built_outputs(kit):
 
 def needed_for(kit, target, output):
     """The target, its output file and everything ninja builds it from."""
-    r = subprocess.run(["ninja", "-C", os.path.join(kit, "build", "student"), "-t", "inputs", target],
-                       capture_output=True, text=True)
-    return set(r.stdout.split()) | {output}
+    build = os.path.join(kit, "build", "student")
+    r = subprocess.run(["ninja", "-C", build, "-t", "inputs", target], capture_output=True, text=True)
+    needed = set(r.stdout.split()) | {output}
+    # `-t inputs` names a phony edge but not what it stands for: the precompiled header's
+    # object library (core/boxes_pch, which every library waits for) is its object.
+    q = subprocess.run(["ninja", "-C", build, "-t", "query", *sorted(needed)], capture_output=True, text=True)
+    phony = False
+    for line in q.stdout.splitlines():
+        if not line.startswith(" "):
+            phony = False
+        elif line.strip() == "input: phony":
+            phony = True
+        elif line.startswith("  ") and line.strip().endswith(":"):
+            phony = phony and line.strip() == "input: phony"
+        elif phony and line.startswith("    "):
+            needed.add(line.split()[-1])
+    return needed
 
 
 def case_fresh(kit, ex):

@@ -193,7 +193,7 @@ TEST_SUITE("exercise 4.3") {
         CHECK(prims[0].centroid.z == 0.5f);
         CHECK(cost == doctest::Approx(1.0 + 12.0 / 18.0).epsilon(1e-6));
     }
-    TEST_CASE("binned SAH: points on a line (a node without area) give no split, not a NaN cost") {
+    TEST_CASE("binned SAH: points on a line (a node without area) give no split and no NaN cost") {
         // Every cost would be 0 / 0: no split, for two primitives and for more.
         for (size_t n : {2u, 3u}) {
             INFO(n << " points");
@@ -208,7 +208,7 @@ TEST_SUITE("exercise 4.3") {
             CHECK(cost == kInfinity<float>);
         }
     }
-    TEST_CASE("binned SAH: boxes whose areas overflow float give no split, not a NaN-priced one") {
+    TEST_CASE("binned SAH: boxes whose areas overflow float give no NaN-priced split") {
         // Half-size 10^20: each area is about 2.4e41, beyond float's 3.4e38, so every plane
         // prices inf / inf = NaN and none is cheaper than no split.
         test::FpTrapsOff nanOnPurpose;  // the NaN prices are the case under test

@@ -151,6 +151,23 @@ class Score(unittest.TestCase):
         with unittest.mock.patch("builtins.print"):
             self.assertEqual(gen.print_summary(results, equivalent, markdown=True), 0)
 
+    def test_an_exercise_without_mutants_has_no_score(self):
+        # 5.7's body is one call: nothing to mutate, which is not a 100% score; and a row
+        # whose every survivor is argued equivalent has nothing counted either.
+        results = {"5.7": {"outcome": {}},
+                   "5.8": {"outcome": {"5.8-eq": ("survived", "")}}}
+        equivalent = {"5.8-eq": {"exercise": "5.8", "why": "the same on every input"}}
+        self.assertIsNone(gen.score_row("5.7", results["5.7"], equivalent)[5])
+        with unittest.mock.patch("builtins.print") as shown:
+            status = gen.print_summary(results, equivalent, markdown=True)
+        lines = [c.args[0] for c in shown.call_args_list]
+        self.assertIn("| 5.7 | 0 | 0 | 0 | 0 | 0 | no mutants |", lines)
+        self.assertIn("| 5.8 | 1 | 0 | 0 | 1 | 0 | none counted |", lines)
+        self.assertEqual(status, 0)
+        with unittest.mock.patch("builtins.print") as shown:
+            gen.print_summary(results, equivalent)
+        self.assertTrue(any("no mutants" in c.args[0] for c in shown.call_args_list))
+
 
 if __name__ == "__main__":
     unittest.main()

@@ -44,10 +44,9 @@ import hashlib
 import json
 import os
 import re
-import subprocess
 import sys
 import time
-from dataclasses import dataclass, field
+from dataclasses import dataclass
 
 from . import ROOT
 from .. import build as cmake
@@ -307,10 +306,15 @@ def error_lines(output, rel):
 
 # The mutants' build checks bounds: the standard library's (std::array, std::vector) and
 # GLM's (its asserts, which the release flags' NDEBUG turns off: glm::vec3's operator[]
-# then reads x for index 3). A loop one past its end is a crash the tests see, as CI's
-# sanitizer run sees it, instead of a read the release build may survive. -O2: the same
-# arithmetic as -O3 (no fast math, no contraction) at less compile time.
-CHECKED = {"CMAKE_CXX_FLAGS": "-D_GLIBCXX_ASSERTIONS", "CMAKE_CXX_FLAGS_RELEASE": "-O2"}
+# then reads x for index 3), and a plain array's (-fsanitize=bounds, stopping at the first
+# error). A loop one past its end is a crash the tests see, as CI's sanitizer run sees it,
+# instead of a read the release build may survive. A local variable read before it is
+# written holds a pattern (-ftrivial-auto-var-init=pattern: NaN for a float), not whatever the
+# stack held, which may be the right value. -O2: the same arithmetic as -O3 (no fast math,
+# no contraction) at less compile time.
+CHECKED = {"CMAKE_CXX_FLAGS": "-D_GLIBCXX_ASSERTIONS -fsanitize=bounds -fno-sanitize-recover=bounds"
+                              " -ftrivial-auto-var-init=pattern",
+           "CMAKE_CXX_FLAGS_RELEASE": "-O2"}
 
 def build_tree(tree):
     """The private tree's build: mutants.py's (no step programs, no link-time optimisation)
@@ -455,8 +459,15 @@ def score_row(ex_id, entry, equivalent):
     eq = [k for k in survivors if k in equivalent]
     left = [k for k in survivors if k not in equivalent]
     counted = killed + len(left)
-    score = 100.0 * killed / counted if counted else 100.0
+    score = 100.0 * killed / counted if counted else None  # nothing to score
     return len(outcome), stillborn, killed, len(eq), left, score
+
+
+def score_text(n, score):
+    """The score column: a percentage, or why there is none."""
+    if score is not None:
+        return f"{score:.1f}%"
+    return "no mutants" if n == 0 else "none counted"
 
 
 def print_summary(results, equivalent, chosen=None, descriptions=None, markdown=False):
@@ -470,7 +481,8 @@ def print_summary(results, equivalent, chosen=None, descriptions=None, markdown=
     print(f"{'exercise':<9} {'mutants':>7} {'no build':>8} {'killed':>6} {'equivalent':>10} "
           f"{'survived':>8} {'score':>7}")
     for ex_id, n, still, killed, eq, left, score in rows:
-        print(f"{ex_id:<9} {n:>7} {still:>8} {killed:>6} {eq:>10} {len(left):>8} {score:>6.1f}%")
+        print(f"{ex_id:<9} {n:>7} {still:>8} {killed:>6} {eq:>10} {len(left):>8} "
+              f"{score_text(n, score):>7}")
     total_k = sum(r[3] for r in rows)
     total_left = sum(len(r[5]) for r in rows)
     if rows:
@@ -484,8 +496,12 @@ def print_summary(results, equivalent, chosen=None, descriptions=None, markdown=
         for ex_id, k in survivors:
             d = (descriptions or {}).get(k) or results[ex_id].get("descriptions", {}).get(k, "")
             print(f"  {k}: {d}")
-    low = [r[0] for r in rows if r[6] < 95.0]
-    return 1 if low else 0
+    return 1 if any(too_low(r) for r in rows) else 0
+
+
+def too_low(row):
+    """Below the 95% every exercise's suite must reach (an exercise without mutants has no score)."""
+    return row[6] is not None and row[6] < 95.0
 
 
 def print_markdown(rows):
@@ -493,13 +509,13 @@ def print_markdown(rows):
     print("| exercise | generated | stillborn | killed | equivalent | survived | score |")
     print("|---|---:|---:|---:|---:|---:|---:|")
     for ex_id, n, still, killed, eq, left, score in rows:
-        print(f"| {ex_id} | {n} | {still} | {killed} | {eq} | {len(left)} | {score:.1f}% |")
+        print(f"| {ex_id} | {n} | {still} | {killed} | {eq} | {len(left)} | {score_text(n, score)} |")
     total_k = sum(r[3] for r in rows)
     total_left = sum(len(r[5]) for r in rows)
     print(f"| all | {sum(r[1] for r in rows)} | {sum(r[2] for r in rows)} | {total_k} | "
           f"{sum(r[4] for r in rows)} | {total_left} | "
           f"{100.0 * total_k / max(1, total_k + total_left):.1f}% |")
-    return 1 if any(r[6] < 95.0 for r in rows) else 0
+    return 1 if any(too_low(r) for r in rows) else 0
 
 
 def main(argv):
@@ -579,7 +595,7 @@ def main(argv):
             }
             save_results(results)
             n, still, killed, eq, left, score = score_row(e.id, results[e.id], equivalent)
-            say(f"[generated] {e.id}: {killed} of {killed + len(left)} killed ({score:.1f}%), "
+            say(f"[generated] {e.id}: {killed} of {killed + len(left)} killed ({score_text(n, score)}), "
                 f"{eq} equivalent, {still} do not compile, in {results[e.id]['seconds']:.0f} s")
     status = print_summary(results, equivalent, {e.id for e in chosen})
     print(f"\n{len(chosen)} exercises in {time.monotonic() - started:.0f} s "

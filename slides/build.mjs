@@ -506,7 +506,7 @@ export function chromiumPath() {
 function main() {
   const args = parseArgs(process.argv.slice(2));
   if (!fs.existsSync(path.join(here, "node_modules", ".bin", "marp"))) {
-    say("Marp is not installed: run tools/deps.sh slides (npm ci --prefix slides)");
+    say("Marp is not installed: run tools/deps.sh slides (npm ci in slides/)");
     process.exit(1);
   }
   const deckDir = path.join(args.out, "slides");

@@ -39,7 +39,7 @@ if (!chromium) {
   process.exit(SKIP);
 }
 if (!fs.existsSync(path.join(here, "node_modules", "playwright-core")) || !fs.existsSync(path.join(here, "node_modules", ".bin", "marp"))) {
-  console.log("SKIP: the slides' npm packages are missing; tools/deps.sh slides runs npm ci --prefix slides");
+  console.log("SKIP: the slides' npm packages are missing; tools/deps.sh slides runs npm ci in slides/");
   process.exit(SKIP);
 }
 const { countSlides, deckNames } = await import("./build.mjs");

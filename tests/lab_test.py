@@ -271,7 +271,7 @@ def deps_scenario(user):
     check(not owned_in_temp(uid), "deps.sh slides: npm's log left nothing in /tmp")
 
     rc, out = user.run(deps + ["slides"], PATH=path, FAKE_NPM_FAIL="1")
-    check(rc == 1 and "npm ci --prefix slides failed" in out and "E404 no such package" in out,
+    check(rc == 1 and "npm ci in slides/ failed" in out and "E404 no such package" in out,
           f"deps.sh slides, npm fails: exit 1 with npm's last lines ({tail(out, 4)})")
     check(not owned_in_temp(uid), "deps.sh slides, npm fails: its log is gone from /tmp")
 

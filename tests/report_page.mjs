@@ -37,7 +37,7 @@ if (!chromium) {
 }
 const playwrightDir = path.join(root, "slides", "node_modules", "playwright-core");
 if (!fs.existsSync(playwrightDir)) {
-  console.log("SKIP: playwright-core is missing; tools/deps.sh slides runs npm ci --prefix slides");
+  console.log("SKIP: playwright-core is missing; tools/deps.sh slides runs npm ci in slides/");
   process.exit(SKIP);
 }
 const steps = fs.existsSync(out) ? fs.readdirSync(out).filter((f) => /^\d\d_[a-z0-9_]+\.json$/.test(f)).map((f) => f.slice(0, -5)).filter((s) => fs.existsSync(path.join(root, "steps", s))).sort() : [];

@@ -6,7 +6,7 @@
 # are the machine's, for every user) and exits 1. Its logs are private temporary files,
 # removed when it ends, whatever the outcome: several users may run it at once.
 # The group slides also installs the slides' npm packages (Marp, playwright-core) with
-# `npm ci --prefix slides` from slides/package-lock.json when they are missing or stale.
+# `npm ci` in slides/ from slides/package-lock.json when they are missing or stale.
 set -euo pipefail
 root=$(cd "$(dirname "$0")/.." && pwd)
 groups=(build test report slides fuzz grade bench watch)
@@ -73,13 +73,16 @@ optional_for() {
   esac
 }
 
-slides_npm() { # npm ci --prefix slides, when the group slides is asked for and the lock is newer
+# npm ci run inside slides/, not with --prefix: --prefix also moves npm's machine-wide
+# settings file ({prefix}/etc/npmrc), so a lab's proxy, CA file or registry mirror there
+# would be ignored.
+slides_npm() { # npm ci in slides/, when the group slides is asked for and the lock is newer
   [[ " $* " == *" slides "* ]] || return 0
   local stamp=$root/slides/node_modules/.package-lock.json
   [[ -f $stamp && ! $root/slides/package-lock.json -nt $stamp ]] && return 0
-  echo "[deps] npm ci --prefix slides (Marp and playwright-core, pinned in slides/package-lock.json)" >&2
+  echo "[deps] npm ci in slides/ (Marp and playwright-core, pinned in slides/package-lock.json)" >&2
   open_log npm.log
-  npm ci --prefix "$root/slides" --no-audit --no-fund >"$log" 2>&1 || failed "npm ci --prefix slides" "$log"
+  (cd "$root/slides" && npm ci --no-audit --no-fund) >"$log" 2>&1 || failed "npm ci in slides/" "$log"
 }
 
 wanted=()

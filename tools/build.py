@@ -12,6 +12,7 @@ The compiler cache (ccache) is the CMake files' business: the top CMakeLists.txt
 where it is installed (BOXES_CCACHE), so every preset, the grader's tree and a plain
 `cmake -B` get it alike.
 """
+import json
 import os
 import re
 import subprocess
@@ -74,12 +75,41 @@ def cached_settings(build):
             if "=" in line and not line.startswith(("//", "#"))}
 
 
+def preset_settings(source, preset):
+    """{name: value} of a configure preset's cacheVariables (with those it inherits), as
+    CMakeCache.txt holds them; not the compiler, which CMake stores as the path it found."""
+    try:
+        with open(os.path.join(source, "CMakePresets.json"), encoding="utf-8") as f:
+            presets = {p["name"]: p for p in json.load(f).get("configurePresets", [])}
+    except (OSError, ValueError):
+        return {}
+    settings, seen = {}, set()
+
+    def add(name):
+        p = presets.get(name)
+        if p is None or name in seen:
+            return
+        seen.add(name)
+        inherits = p.get("inherits", [])
+        for parent in reversed([inherits] if isinstance(inherits, str) else inherits):
+            add(parent)
+        for k, v in p.get("cacheVariables", {}).items():
+            settings[k] = str(v.get("value", "") if isinstance(v, dict) else v)
+
+    add(preset)
+    return {k: v for k, v in settings.items() if not k.endswith("_COMPILER")}
+
+
 def configured(tree):
-    """Whether the build folder is configured, with the tree's -D settings."""
+    """Whether the build folder is configured with the settings wanted: its preset's (a
+    folder configured before the preset gained a setting is configured again, so an old
+    build/student gets the precompiled header) and the tree's -D settings on top."""
     if not os.path.exists(os.path.join(tree.build, "build.ninja")):
         return False
     have = cached_settings(tree.build)
-    return all(have.get(k) == str(v) for k, v in tree.cache.items())
+    wanted = preset_settings(tree.source, tree.preset) if tree.preset else {}
+    wanted.update({k: str(v) for k, v in tree.cache.items()})
+    return all(have.get(k) == v for k, v in wanted.items())
 
 
 # What a failed build says --------------------------------------------------------------------

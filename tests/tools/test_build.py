@@ -59,6 +59,31 @@ class Commands(unittest.TestCase):
             self.assertTrue(build.configured(tree))
 
 
+    def test_a_folder_configured_before_its_preset_gained_a_setting_is_configured_again(self):
+        with tempfile.TemporaryDirectory() as tmp:
+            with open(os.path.join(tmp, "CMakePresets.json"), "w") as f:
+                f.write('{"version": 3, "configurePresets": ['
+                        '{"name": "base", "cacheVariables": {"CMAKE_BUILD_TYPE": "Release"}},'
+                        '{"name": "student", "inherits": "base", "cacheVariables": {'
+                        '"BOXES_PCH": "ON", "CMAKE_CXX_COMPILER": "g++",'
+                        '"FLAGS": {"type": "STRING", "value": "-O1 -DNDEBUG"}}}]}')
+            tree = build.Tree.of_preset(tmp, "student", BOXES_TESTS="ON")
+            self.assertEqual(build.preset_settings(tmp, "student"),
+                             {"CMAKE_BUILD_TYPE": "Release", "BOXES_PCH": "ON", "FLAGS": "-O1 -DNDEBUG"})
+            os.makedirs(tree.build)
+            open(os.path.join(tree.build, "build.ninja"), "w").close()
+            old = ("CMAKE_BUILD_TYPE:STRING=Release\nFLAGS:STRING=-O1 -DNDEBUG\n"
+                   "CMAKE_CXX_COMPILER:FILEPATH=/usr/bin/g++\nBOXES_TESTS:BOOL=ON\n")
+            with open(os.path.join(tree.build, "CMakeCache.txt"), "w") as f:
+                f.write(old)  # configured before the preset had BOXES_PCH
+            self.assertFalse(build.configured(tree))
+            with open(os.path.join(tree.build, "CMakeCache.txt"), "w") as f:
+                f.write(old + "BOXES_PCH:BOOL=ON\n")
+            self.assertTrue(build.configured(tree))
+            tree.cache["BOXES_PCH"] = "OFF"  # the tree's own settings win over the preset's
+            self.assertFalse(build.configured(tree))
+
+
 class FirstError(unittest.TestCase):
     SRC = "/w/src"
 

@@ -163,6 +163,8 @@ class Score(unittest.TestCase):
         lines = [c.args[0] for c in shown.call_args_list]
         self.assertIn("| 5.7 | 0 | 0 | 0 | 0 | 0 | no mutants |", lines)
         self.assertIn("| 5.8 | 1 | 0 | 0 | 1 | 0 | none counted |", lines)
+        # The "all" row follows the same rule: nothing counted over both rows, so no 0.0%.
+        self.assertIn("| all | 1 | 0 | 0 | 1 | 0 | none counted |", lines)
         self.assertEqual(status, 0)
         with unittest.mock.patch("builtins.print") as shown:
             gen.print_summary(results, equivalent)

@@ -483,12 +483,10 @@ def print_summary(results, equivalent, chosen=None, descriptions=None, markdown=
     for ex_id, n, still, killed, eq, left, score in rows:
         print(f"{ex_id:<9} {n:>7} {still:>8} {killed:>6} {eq:>10} {len(left):>8} "
               f"{score_text(n, score):>7}")
-    total_k = sum(r[3] for r in rows)
-    total_left = sum(len(r[5]) for r in rows)
     if rows:
-        print(f"{'all':<9} {sum(r[1] for r in rows):>7} {sum(r[2] for r in rows):>8} {total_k:>6} "
-              f"{sum(r[4] for r in rows):>10} {total_left:>8} "
-              f"{100.0 * total_k / max(1, total_k + total_left):>6.1f}%")
+        n, still, killed, eq, left, score = totals(rows)
+        print(f"{'all':<9} {n:>7} {still:>8} {killed:>6} {eq:>10} {left:>8} "
+              f"{score_text(n, score):>7}")
     survivors = [(r[0], k) for r in rows for k in r[5]]
     if survivors:
         print("\nsurvivors (kill them with a test case, or argue them equivalent in "
@@ -497,6 +495,15 @@ def print_summary(results, equivalent, chosen=None, descriptions=None, markdown=
             d = (descriptions or {}).get(k) or results[ex_id].get("descriptions", {}).get(k, "")
             print(f"  {k}: {d}")
     return 1 if any(too_low(r) for r in rows) else 0
+
+
+def totals(rows):
+    """The "all" row: the columns summed, the score over every killed and surviving mutant."""
+    killed = sum(r[3] for r in rows)
+    left = sum(len(r[5]) for r in rows)
+    score = 100.0 * killed / (killed + left) if killed + left else None
+    return (sum(r[1] for r in rows), sum(r[2] for r in rows), killed, sum(r[4] for r in rows),
+            left, score)
 
 
 def too_low(row):
@@ -510,11 +517,8 @@ def print_markdown(rows):
     print("|---|---:|---:|---:|---:|---:|---:|")
     for ex_id, n, still, killed, eq, left, score in rows:
         print(f"| {ex_id} | {n} | {still} | {killed} | {eq} | {len(left)} | {score_text(n, score)} |")
-    total_k = sum(r[3] for r in rows)
-    total_left = sum(len(r[5]) for r in rows)
-    print(f"| all | {sum(r[1] for r in rows)} | {sum(r[2] for r in rows)} | {total_k} | "
-          f"{sum(r[4] for r in rows)} | {total_left} | "
-          f"{100.0 * total_k / max(1, total_k + total_left):.1f}% |")
+    n, still, killed, eq, left, score = totals(rows)
+    print(f"| all | {n} | {still} | {killed} | {eq} | {left} | {score_text(n, score)} |")
     return 1 if any(too_low(r) for r in rows) else 0
 
 

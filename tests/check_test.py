@@ -139,16 +139,12 @@ def needed_for(kit, target, output):
     # `-t inputs` names a phony edge but not what it stands for: the precompiled header's
     # object library (core/boxes_pch, which every library waits for) is its object.
     q = subprocess.run(["ninja", "-C", build, "-t", "query", *sorted(needed)], capture_output=True, text=True)
-    phony = False
+    section = None  # the last header line: a target, "input: RULE" or "outputs:"
     for line in q.stdout.splitlines():
-        if not line.startswith(" "):
-            phony = False
-        elif line.strip() == "input: phony":
-            phony = True
-        elif line.startswith("  ") and line.strip().endswith(":"):
-            phony = phony and line.strip() == "input: phony"
-        elif phony and line.startswith("    "):
-            needed.add(line.split()[-1])
+        if not line.startswith("    "):
+            section = line.strip()
+        elif section == "input: phony":
+            needed.add(line.split()[-1])  # a path, after "|" or "||" when implicit or order-only
     return needed
 
 

@@ -281,7 +281,7 @@ def case_watch(kit, exercise, correct_text, poll):
     cmd = [sys.executable, "-m", "tools.check", exercise.id, "--watch", "--no-pictures"] + (["--poll"] if poll else [])
     p = subprocess.Popen(cmd, cwd=kit, stdout=subprocess.PIPE, stderr=subprocess.STDOUT, text=True,
                          start_new_session=True)
-    lines, events = [], []
+    lines = []
     cond = threading.Condition()
 
     def reader():

@@ -74,9 +74,11 @@ class BubblewrapPrefix(unittest.TestCase):
         self.assertNotIn(f"--tmpfs {home}", text)  # absent, nothing to cover
         self.assertIn(f"--bind {work} {work}", text)
         self.assertEqual(prefix[prefix.index("--chdir") + 1], work)
-        # The folders above the writable one are made reachable (0755), not 0700.
+        # The folders above the writable one can be passed (not 0700, which a user of the
+        # sandbox's own could not pass), not listed or written (not 0755, which the folders'
+        # owner, the grader without root, could).
         for up in (home, os.path.dirname(os.path.dirname(work))):
-            self.assertIn(f"--perms 0755 --dir {up}", text)
+            self.assertIn(f"--perms 0111 --dir {up}", text)
         # A hidden folder the system shows is covered, a readable one inside it shown again.
         self.assertIn("--tmpfs /usr/share", text)
         self.assertLess(prefix.index("/usr/share"), prefix.index(data))

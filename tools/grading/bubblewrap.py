@@ -104,8 +104,10 @@ def bwrap_prefix(writable, cwd, tmp_bytes, hidden=(), readable=(), scratch=None,
             prefix += ["--tmpfs", d]
     prefix += size + ["--perms", "1777", "--tmpfs", "/tmp"]
     prefix += size + ["--perms", "1777", "--tmpfs", "/dev/shm"]
-    # The folders above a bound one: bubblewrap would make them 0700 (a user that is not
-    # root could not reach the folder by its path); those of the system exist already.
+    # The folders above a bound one (those of the system exist already): bubblewrap would make
+    # them 0700, which a user id of the sandbox's own could not pass. They are 0111, passable
+    # and nothing else: without root the sandbox runs as the folders' owner, and with 0755 it
+    # could list them (the path to the clone in a home) and write into them.
     made = set(SYSTEM_DIRS) | {"/", "/tmp", "/dev", "/proc"}
     for d in [r for r in readable if os.path.exists(r)] + list(writable) + ([scratch] if scratch else []):
         parts = d.strip("/").split("/")[:-1]
@@ -114,7 +116,7 @@ def bwrap_prefix(writable, cwd, tmp_bytes, hidden=(), readable=(), scratch=None,
             shown = any(_inside(up, s) for s in SYSTEM_DIRS) and not any(_inside(up, c) for c in covers)
             if up not in made and not shown:
                 made.add(up)
-                prefix += ["--perms", "0755", "--dir", up]
+                prefix += ["--perms", "0111", "--dir", up]
     for d in readable:
         if os.path.exists(d):
             prefix += ["--ro-bind", d, d]

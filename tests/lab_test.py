@@ -17,7 +17,8 @@ their first builds take the administrator's objects. Then, with stand-ins for dp
 PATH (no network, no install): a missing package names what the administrator runs once;
 npm's log goes nowhere shared (the old /tmp log broke the second user); a failing npm shows
 its output; Ctrl-C during npm leaves nothing behind. The users and their homes are removed
-at the end.
+at the end; at the start, so are those an interrupted run left whose work folder is gone
+(each user's comment field names its run's work folder).
 """
 import hashlib
 import os
@@ -83,6 +84,17 @@ def user_names(work):
     return [f"boxes-lab{tag}{c}" for c in "ab"]
 
 
+COMMENT = "boxes lab test in "  # + the work folder, in the user's comment field (no ':' there)
+
+
+def remove_leftovers():
+    """Users an interrupted run in another tree left: their work folder is gone."""
+    for entry in pwd.getpwall():
+        if entry.pw_name.startswith("boxes-lab") and entry.pw_gecos.startswith(COMMENT):
+            if not os.path.isdir(entry.pw_gecos[len(COMMENT):]):
+                remove_user(entry.pw_name)
+
+
 def remove_user(name):
     try:
         uid = pwd.getpwnam(name).pw_uid
@@ -114,8 +126,9 @@ def owned_in_temp(uid):
 
 
 class User:
-    def __init__(self, name):
-        subprocess.run(["useradd", "--create-home", "--shell", "/bin/bash", name], check=True,
+    def __init__(self, name, work):
+        comment = ["--comment", COMMENT + work] if ":" not in work else []  # ':' ends the field
+        subprocess.run(["useradd", "--create-home", "--shell", "/bin/bash", *comment, name], check=True,
                        capture_output=True)
         self.pw = pwd.getpwnam(name)
         self.name, self.home = name, self.pw.pw_dir
@@ -307,6 +320,7 @@ def main():
             print(f"FAIL: {tool} is missing (util-linux, passwd)")
             return 1
     names = user_names(work)
+    stale = user_names(os.path.join(work, "gone"))[0]
     placed = []
     users = []
     try:
@@ -318,9 +332,19 @@ def main():
                 placed.append(path)
             check(os.lstat(path).st_uid == 0, f"{path} is root's: an ordinary user cannot write it")
         cache = fill_lab_cache(work) if CCACHE else None
+        # A user as an interrupted run leaves it, its work folder removed since: it goes.
+        planted = ":" not in work  # ':' cannot be in a comment field
+        if planted:
+            subprocess.run(["useradd", "--create-home", "--comment", COMMENT + os.path.join(work, "gone"), stale],
+                           check=True, capture_output=True)
+        stale_home = pwd.getpwnam(stale).pw_dir if planted else None
+        remove_leftovers()
+        if planted:
+            check(stale not in {e.pw_name for e in pwd.getpwall()} and not os.path.exists(stale_home),
+                  "a user left by an interrupted run whose work folder is gone is removed, with its home")
         for name in names:
             remove_user(name)  # a leftover of an interrupted run
-            users.append(User(name))
+            users.append(User(name, work))
             users[-1].lab_cache = cache
             make_clone(users[-1])
         threads = [threading.Thread(target=scenario, args=(u, u is users[0])) for u in users]
@@ -334,7 +358,7 @@ def main():
               flush=True)
         deps_scenario(users[0])
     finally:
-        for name in names:
+        for name in names + [stale]:
             remove_user(name)
         for path in placed:
             os.remove(path)

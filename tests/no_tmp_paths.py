@@ -7,7 +7,8 @@ A fixed name in the shared /tmp belongs to whichever user made it first: a secon
 command then fails on it (tools/deps.sh's old logs did). Logs, scratch and caches go into the
 clone (build/) or a private folder from mktemp or tempfile, removed when the command ends.
 Everything but tests/ and the documentation is checked: /tmp/NAME, and mktemp or mkdtemp
-given /tmp itself (the user's TMPDIR is theirs to choose).
+given /tmp itself (the user's TMPDIR is theirs to choose). And every tools test that makes
+temporary folders imports tests/tools/scratch.py, which removes them when it ends.
 """
 import os
 import re
@@ -36,6 +37,19 @@ def files(root):
     return [f for f in listed if not SKIP.search(f)]
 
 
+def unscratched(root):
+    """The tools tests that use tempfile without tests/tools/scratch.py."""
+    folder = os.path.join(root, "tests", "tools")
+    found = []
+    for name in sorted(os.listdir(folder)) if os.path.isdir(folder) else []:
+        if name.startswith("test_") and name.endswith(".py"):
+            with open(os.path.join(folder, name), encoding="utf-8") as f:
+                text = f.read()
+            if "tempfile" in text and "from tests.tools import scratch" not in text:
+                found.append(f"tests/tools/{name}: temporary folders without tests.tools.scratch (left in /tmp)")
+    return found
+
+
 def main(argv):
     root = os.path.abspath(argv[0] if argv else os.path.dirname(os.path.dirname(os.path.abspath(__file__))))
     found, checked = [], 0
@@ -50,9 +64,10 @@ def main(argv):
             for pattern, what in PATTERNS:
                 if pattern.search(line):
                     found.append(f"{rel}:{number}: {what}: {line.strip()[:120]}")
+    found += unscratched(root)
     for f in found:
         print("FAIL  " + f)
-    print(f"{checked} files checked, {len(found)} fixed /tmp paths")
+    print(f"{checked} files checked, {len(found)} found (fixed /tmp paths, unscratched tools tests)")
     return 1 if found or checked == 0 else 0
 
 

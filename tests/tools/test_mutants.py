@@ -9,6 +9,7 @@ import os
 import tempfile
 import unittest
 
+from tests.tools import scratch  # noqa: F401  (tempfile's folders: one, removed at exit)
 from tools import ROOT
 from tools.grading import mutants, safeguards
 from tools.grading.submissions import write_files

@@ -84,7 +84,12 @@ def user_names(work):
     return [f"boxes-lab{tag}{c}" for c in "ab"]
 
 
-COMMENT = "boxes lab test in "  # + the work folder, in the user's comment field (no ':' there)
+COMMENT = "boxes lab test in "  # + the work folder, in the user's comment field
+
+
+def comment_args(work):
+    """useradd's arguments naming the run's work folder (none where ':', which ends the field, is in it)."""
+    return ["--comment", COMMENT + work] if ":" not in work else []
 
 
 def remove_leftovers():
@@ -127,9 +132,8 @@ def owned_in_temp(uid):
 
 class User:
     def __init__(self, name, work):
-        comment = ["--comment", COMMENT + work] if ":" not in work else []  # ':' ends the field
-        subprocess.run(["useradd", "--create-home", "--shell", "/bin/bash", *comment, name], check=True,
-                       capture_output=True)
+        subprocess.run(["useradd", "--create-home", "--shell", "/bin/bash", *comment_args(work), name],
+                       check=True, capture_output=True)
         self.pw = pwd.getpwnam(name)
         self.name, self.home = name, self.pw.pw_dir
         self.clone = os.path.join(self.home, "boxes")
@@ -333,9 +337,9 @@ def main():
             check(os.lstat(path).st_uid == 0, f"{path} is root's: an ordinary user cannot write it")
         cache = fill_lab_cache(work) if CCACHE else None
         # A user as an interrupted run leaves it, its work folder removed since: it goes.
-        planted = ":" not in work  # ':' cannot be in a comment field
+        planted = bool(comment_args(work))
         if planted:
-            subprocess.run(["useradd", "--create-home", "--comment", COMMENT + os.path.join(work, "gone"), stale],
+            subprocess.run(["useradd", "--create-home", *comment_args(os.path.join(work, "gone")), stale],
                            check=True, capture_output=True)
         stale_home = pwd.getpwnam(stale).pw_dir if planted else None
         remove_leftovers()
